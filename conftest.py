@@ -1,0 +1,135 @@
+"""Fixtures shared by every test tier (pytest loads this for all tests in the workspace).
+
+- Core tests need none of these.
+- Wiring tests use `ros_master` (a roscore on a free port, with its own ROS_LOG_DIR) and
+  `rosrun` (start a node the way a user would; every process is stopped at teardown).
+- Catalogue and end-to-end tests use `pg_dsn`: a throw-away database on the PostgreSQL server
+  that `scripts/setup.sh` started.
+"""
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import tempfile
+import time
+import uuid
+
+import pytest
+
+WORKSPACE = os.path.dirname(os.path.abspath(__file__))
+CONFIG = os.path.join(WORKSPACE, "config", "rascal.yaml")
+PG_ADMIN_DSN = os.environ.get(
+    "RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0.1:5432/rascal")
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _stop(proc, timeout=10.0):
+    """SIGINT the whole process group (as Ctrl-C would), then SIGKILL what is left."""
+    if proc.poll() is not None:
+        return
+    try:
+        os.killpg(proc.pid, signal.SIGINT)
+        proc.wait(timeout=timeout)
+    except (subprocess.TimeoutExpired, ProcessLookupError):
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        proc.wait()
+
+
+class RosMaster:
+    """A roscore on a free port; `env` is what child processes need to talk to it."""
+
+    def __init__(self):
+        self.port = free_port()
+        self.log_dir = tempfile.mkdtemp(prefix="rascal_roslog_")
+        self.uri = "http://127.0.0.1:%d" % self.port
+        self.env = dict(os.environ, ROS_MASTER_URI=self.uri, ROS_LOG_DIR=self.log_dir,
+                        ROS_HOSTNAME="127.0.0.1", ROS_HOME=self.log_dir, PYTHONUNBUFFERED="1")
+        self.env.pop("ROS_IP", None)
+        self.proc = subprocess.Popen(["roscore", "-p", str(self.port)], env=self.env,
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT,
+                                     start_new_session=True)
+        deadline = time.monotonic() + 30.0
+        while time.monotonic() < deadline:
+            if self.run(["rosparam", "get", "/run_id"], check=False).returncode == 0:
+                return
+            time.sleep(0.2)
+        self.stop()
+        raise RuntimeError("roscore did not come up on port %d" % self.port)
+
+    def run(self, cmd, check=True, timeout=60.0, **kw):
+        """Run a command against this master and wait for it (rosparam, rosservice, ...)."""
+        return subprocess.run(cmd, env=self.env, capture_output=True, text=True, check=check,
+                              timeout=timeout, **kw)
+
+    def stop(self):
+        _stop(self.proc)
+        shutil.rmtree(self.log_dir, ignore_errors=True)
+
+
+class Rosrun:
+    """Starts nodes with `rosrun` (as on the field rig) and stops them all at teardown."""
+
+    def __init__(self, master):
+        self.master = master
+        self.procs = []
+
+    def __call__(self, package, executable, *args, env=None, **popen_kw):
+        e = dict(self.master.env, **(env or {}))
+        popen_kw.setdefault("stdout", subprocess.PIPE)
+        popen_kw.setdefault("stderr", subprocess.STDOUT)
+        proc = subprocess.Popen(["rosrun", package, executable, *args], env=e, text=True,
+                                start_new_session=True, **popen_kw)
+        self.procs.append(proc)
+        return proc
+
+    def stop_all(self):
+        for p in reversed(self.procs):
+            _stop(p)
+
+
+@pytest.fixture(scope="session")
+def ros_master_session():
+    m = RosMaster()
+    yield m
+    m.stop()
+
+
+@pytest.fixture
+def ros_master(ros_master_session):
+    """A running master; parameters are cleared between tests."""
+    ros_master_session.run(["rosparam", "delete", "/"], check=False)
+    yield ros_master_session
+
+
+@pytest.fixture
+def rosrun(ros_master):
+    r = Rosrun(ros_master)
+    yield r
+    r.stop_all()
+
+
+@pytest.fixture
+def pg_dsn():
+    """A fresh, empty database for one test; dropped afterwards."""
+    psycopg2 = pytest.importorskip("psycopg2")
+    name = "rascal_test_" + uuid.uuid4().hex[:12]
+    admin = psycopg2.connect(PG_ADMIN_DSN)
+    admin.autocommit = True
+    with admin.cursor() as cur:
+        cur.execute("CREATE DATABASE " + name)  # name is generated above, never user input
+    dsn = PG_ADMIN_DSN.rsplit("/", 1)[0] + "/" + name
+    yield dsn
+    with admin.cursor() as cur:
+        cur.execute("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s",
+                    (name,))
+        cur.execute("DROP DATABASE IF EXISTS " + name)
+    admin.close()

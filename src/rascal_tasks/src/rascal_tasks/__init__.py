@@ -1,0 +1,1 @@
+"""RASCAL task layer: configuration, state machine, stations, catalogue and archive."""
