@@ -62,7 +62,10 @@ fi
 
 # ---------------------------------------------------------------- catkin build
 if [ ! -f build/Makefile ]; then
-  cmake -S . -B build -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_DEVEL_PREFIX="$here/devel" \
+  # Python3_EXECUTABLE too: Debian's kdl_parser -> urdf -> pluginlib pulls in ament_cmake_core,
+  # which otherwise runs the first python3 on PATH (a pyenv one here, without ament_package).
+  cmake -S . -B build -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
+        -DCATKIN_DEVEL_PREFIX="$here/devel" \
         -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON >/dev/null
 fi
 make -C build -j"$(nproc)" --no-print-directory -s 2>&1 | grep -vE '^(\[|-- )' || true

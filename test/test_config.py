@@ -1,0 +1,126 @@
+"""Core tests of the site configuration loader (no ROS master)."""
+import copy
+import os
+
+import pytest
+import yaml
+
+from rascal_tasks.config import ConfigError, config_from_dict, load_config, top_down_reachable
+
+WORKSPACE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHIPPED = os.path.join(WORKSPACE, "config", "rascal.yaml")
+
+
+@pytest.fixture(scope="module")
+def shipped():
+    with open(SHIPPED) as f:
+        return yaml.safe_load(f)
+
+
+def test_shipped_config_passes():
+    cfg = load_config(SHIPPED)
+    assert set(cfg.stations) == {"pickup", "scale", "camera", "discard"}
+    assert cfg.station_order() == ["scale", "camera", "discard"]
+    assert cfg.stations["camera"].place_at == (0.28, -0.30)
+    assert cfg.resolve(cfg["archive"]["root"]) == os.path.join(WORKSPACE, "var", "archive")
+    assert len(cfg.hash) == 16
+
+
+def test_config_hash_changes_with_content(shipped):
+    a = config_from_dict(copy.deepcopy(shipped))
+    changed = copy.deepcopy(shipped)
+    changed["survey"]["step"] = 0.15
+    assert config_from_dict(changed).hash != a.hash
+
+
+def _set(data, dotted, value):
+    keys = dotted.split(".")
+    node = data
+    for k in keys[:-1]:
+        node = node[k]
+    if value is _DELETE:
+        del node[keys[-1]]
+    else:
+        node[keys[-1]] = value
+
+
+_DELETE = object()
+
+# (dotted key, bad value, text the one-line error must contain)
+BAD = [
+    ("stations.scale.position", "abc", "stations.scale.position: expected [x, y] in metres, got 'abc'"),
+    ("stations.scale.position", [0.3], "stations.scale.position: expected [x, y]"),
+    ("stations.pickup.size", [0.3, -0.1], "stations.pickup.size: expected [length along x"),
+    ("stations.scale.surface_z", "high", "stations.scale.surface_z: expected a number"),
+    ("stations.scale.type", "balance", "stations.scale.type: expected one of pickup, scale"),
+    ("stations.discard.position", [0.9, -0.5], "stations.discard.position: station corner"),
+    ("stations.scale.position", [0.16, 0.25], "overlaps station pickup"),
+    ("stations.camera.place_at", [0.0, -0.30], "stations.camera.place_at: must lie inside"),
+    ("stations.camera.colour_chart.position", [0.6, -0.1], "stations.camera.colour_chart: must lie"),
+    ("arm.travel_z", 0.03, "arm.travel_z: expected a number in metres in [0.05, 0.45], got 0.03"),
+    ("arm.standby", [0.30, -0.30], "arm.standby: inside the archival camera's view"),
+    ("arm.named_poses.home", [0, 0, 0], "arm.named_poses.home: expected 6 joint angles"),
+    ("arm.named_poses.sleep", _DELETE, "arm.named_poses.sleep: missing"),
+    ("survey.z", 0.10, "survey.z: expected at least arm.travel_z"),
+    ("survey.z", 0.45, "survey.z: too high to reach the survey pose"),
+    ("survey.step", 0, "survey.step: expected a number in metres in [0.02, 0.5], got 0"),
+    ("perception.selection_policy", "random", "perception.selection_policy: expected one of nearest"),
+    ("perception.background_clusters", 2.5, "perception.background_clusters: expected an integer"),
+    ("perception.max_sherd_size", 0.01, "perception.max_sherd_size: expected a number"),
+    ("perception.depth_min", True, "perception.depth_min: expected a number"),
+    ("database.dsn", "localhost", "database.dsn: expected a libpq URI"),
+    ("database", _DELETE, "database: missing"),
+    ("archive.root", "", "archive.root: expected a non-empty one-line string"),
+    ("rig.name", "a\nb", "rig.name: expected a non-empty one-line string"),
+    ("recovery.max_grasp_attempts", 0, "recovery.max_grasp_attempts: expected an integer"),
+    ("simulator.mat_colour", [0, 0, 2], "simulator.mat_colour: expected [r, g, b]"),
+    ("simulator.scale_colours", [[0, 0, 0]], "simulator.scale_colours: expected two"),
+    ("survey.stepp", 0.1, "survey.stepp: unknown key"),
+]
+
+
+@pytest.mark.parametrize("key,value,message", BAD, ids=[b[0] + ":" + repr(b[1])[:20] for b in BAD])
+def test_bad_value_is_rejected_with_one_line_naming_the_key(shipped, key, value, message):
+    data = copy.deepcopy(shipped)
+    _set(data, key, value)
+    with pytest.raises(ConfigError) as e:
+        config_from_dict(data, source="config/rascal.yaml")
+    text = str(e.value)
+    assert text.startswith("config/rascal.yaml: ")
+    assert message in text
+    assert "\n" not in text
+
+
+def test_station_overlapping_camera_stand_is_rejected(shipped):
+    data = copy.deepcopy(shipped)
+    data["stations"]["camera"]["stand"]["position"] = [0.30, 0.0]
+    with pytest.raises(ConfigError, match="stations.scale: overlaps the archival camera stand"):
+        config_from_dict(data)
+
+
+def test_missing_station_type_is_rejected(shipped):
+    data = copy.deepcopy(shipped)
+    del data["stations"]["discard"]
+    with pytest.raises(ConfigError, match="stations: expected exactly one station of type discard"):
+        config_from_dict(data)
+
+
+def test_missing_file_and_bad_yaml(tmp_path):
+    with pytest.raises(ConfigError, match="file not found"):
+        load_config(str(tmp_path / "nope.yaml"))
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("stations: [unclosed\n")
+    with pytest.raises(ConfigError, match=r"bad.yaml: not valid YAML \(line"):
+        load_config(str(bad))
+    empty = tmp_path / "empty.yaml"
+    empty.write_text("")
+    with pytest.raises(ConfigError, match="expected a mapping"):
+        load_config(str(empty))
+
+
+def test_top_down_reach_matches_the_arm_geometry():
+    assert top_down_reachable(0.30, 0.0, 0.0)
+    assert top_down_reachable(0.45, 0.0, 0.0)
+    assert not top_down_reachable(0.55, 0.0, 0.0)  # stretched arm is 0.505 m at the wrist
+    assert not top_down_reachable(0.05, 0.0, 0.1)  # over the base
+    assert not top_down_reachable(0.40, 0.0, 0.45)  # too high that far out
