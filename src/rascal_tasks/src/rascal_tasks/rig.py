@@ -1,0 +1,155 @@
+"""What the station workflow needs from the rig, as plain Python.
+
+The workflow core talks only to these small interfaces; `ros_rig.py` implements them over ROS
+(the arm controller's actions, the detector's services, the scale topic, the archival camera
+service). Tests can run the core against the simulator through the same adapters. No ROS here.
+"""
+import math
+from dataclasses import dataclass, field
+from typing import List, Optional, Tuple
+
+
+class RigError(Exception):
+    """A device did not do what was asked; `reason` is the device's one-line explanation."""
+
+    def __init__(self, device: str, code: str, reason: str):
+        super().__init__("%s: %s: %s" % (device, code, reason))
+        self.device = device
+        self.code = code
+        self.reason = reason
+
+
+@dataclass
+class Observation:
+    """One sherd as perception saw it, in base_link (metres, radians)."""
+
+    x: float
+    y: float
+    yaw: float  # major axis
+    length: float
+    width: float
+    height: float  # top surface above the station surface
+    grasp_x: float
+    grasp_y: float
+    grasp_z: float  # ee_gripper_link height for closing
+    grasp_yaw: float  # gripper yaw so the fingers close across the minor axis
+    grasp_width: float  # opening before closing
+    colour: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    score: float = 1.0
+
+    def distance_to(self, x: float, y: float) -> float:
+        return math.hypot(self.x - x, self.y - y)
+
+
+@dataclass
+class ScaleReading:
+    mass: float  # kg
+    stable: bool
+
+
+@dataclass
+class Capture:
+    path: str
+    stamp: float  # shutter time, s
+    width: int
+    height: int
+
+
+@dataclass
+class GraspResult:
+    holding: bool
+    width: float  # m, opening at the end
+
+
+@dataclass
+class Timings:
+    """Seconds (rig clock) spent per phase, the paper's Fig. 10 breakdown."""
+
+    locomotion: float = 0.0
+    grasping: float = 0.0
+    data_collection: float = 0.0
+    perception: float = 0.0
+    phases: dict = field(default_factory=dict)
+
+    def add(self, phase: str, seconds: float):
+        setattr(self, phase, getattr(self, phase) + seconds)
+
+    def total(self) -> float:
+        return self.locomotion + self.grasping + self.data_collection + self.perception
+
+    def as_dict(self) -> dict:
+        return {"locomotion": round(self.locomotion, 3), "grasping": round(self.grasping, 3),
+                "data_collection": round(self.data_collection, 3),
+                "perception": round(self.perception, 3)}
+
+
+class Arm:
+    """Moves ee_gripper_link with the gripper pointing down (the only way RASCAL holds sherds)."""
+
+    def move_down(self, x: float, y: float, z: float, yaw: float, linear: bool = False) -> float:
+        """Move to (x, y, z) with the gripper pointing down at `yaw`; returns seconds taken.
+        Raises RigError (UNREACHABLE, COLLISION, TIMEOUT, PREEMPTED)."""
+        raise NotImplementedError
+
+    def go(self, named: str) -> float:
+        raise NotImplementedError
+
+    def stop(self) -> None:
+        raise NotImplementedError
+
+
+class Gripper:
+    def open(self, width: Optional[float] = None) -> float:
+        """Open to `width` metres between the fingertips (None: fully); returns seconds."""
+        raise NotImplementedError
+
+    def close(self) -> GraspResult:
+        raise NotImplementedError
+
+    def holding(self) -> bool:
+        """Whether the fingers are still stopped short of closed (a sherd is in them)."""
+        raise NotImplementedError
+
+    def width(self) -> float:
+        """Current opening between the fingertips (m)."""
+        raise NotImplementedError
+
+
+class Perception:
+    def calibrate(self, station: str) -> None:
+        raise NotImplementedError
+
+    def detect(self, station: str) -> List[Observation]:
+        raise NotImplementedError
+
+
+class Scale:
+    def tare(self) -> None:
+        raise NotImplementedError
+
+    def read_stable(self, timeout: float) -> ScaleReading:
+        """The first stable reading, or the last reading (stable False) after `timeout`."""
+        raise NotImplementedError
+
+
+class ArchivalCamera:
+    def capture(self, path: str) -> Capture:
+        raise NotImplementedError
+
+
+class Clock:
+    def now(self) -> float:
+        raise NotImplementedError
+
+    def sleep(self, seconds: float) -> None:
+        raise NotImplementedError
+
+
+@dataclass
+class Rig:
+    arm: Arm
+    gripper: Gripper
+    perception: Perception
+    scale: Scale
+    camera: ArchivalCamera
+    clock: Clock

@@ -1,0 +1,100 @@
+"""Station plug-ins: what happens once a sherd is at a station.
+
+A station type is a class registered under the `type` used in config/rascal.yaml; the workflow
+builds its states from the config's station list, so a new kind of station (a profile scanner,
+a second camera) is a new class here plus a config entry, not an edit of the state machine.
+No ROS here: plug-ins use the rig interfaces (`rig.py`) and the batch's recorder.
+"""
+from typing import Dict, Type
+
+from rascal_tasks.rig import RigError
+
+STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
+
+
+def station_type(name: str):
+    """Class decorator: register a plug-in for stations of config `type: <name>`."""
+
+    def register(cls):
+        STATION_PLUGINS[name] = cls
+        cls.type_name = name
+        return cls
+
+    return register
+
+
+class StationPlugin:
+    """Base class. `status` is the catalogue status a sherd reaches when this station is done."""
+
+    type_name = ""
+    status = ""
+    # True: the sherd is released from travel height and never picked up again (discard box).
+    release_from_above = False
+
+    def __init__(self, station, batch):
+        self.station = station  # rascal_tasks.config.Station
+        self.batch = batch  # rascal_tasks.workflow.Batch
+
+    def before_place(self, sherd) -> None:
+        """Called with the sherd in the gripper above the station (e.g. tare the scale)."""
+
+    def after_place(self, sherd) -> str:
+        """Called with the sherd placed and the gripper back at travel height.
+        Returns 'done', or 'failed' when the measurement could not be taken (recorded anyway)."""
+        raise NotImplementedError
+
+
+@station_type("scale")
+class ScaleStation(StationPlugin):
+    status = "weighed"
+
+    def before_place(self, sherd):
+        with self.batch.phase("data_collection"):
+            self.batch.rig.scale.tare()
+
+    def after_place(self, sherd):
+        cfg = self.batch.config["scale"]
+        reading = None
+        with self.batch.phase("data_collection"):
+            for attempt in range(1 + cfg["rereads"]):
+                reading = self.batch.rig.scale.read_stable(cfg["stable_timeout"])
+                if reading.stable:
+                    break
+                self.batch.event(sherd, "scale_unstable", "attempt %d: %.1f g" % (
+                    attempt + 1, reading.mass * 1000))
+        sherd.mass = reading.mass
+        self.batch.recorder.record(self.batch.context, sherd.seq, status=self.status,
+                                   mass=reading.mass, mass_stable=reading.stable)
+        return "done" if reading.stable else "failed"
+
+
+@station_type("archival_camera")
+class ArchivalCameraStation(StationPlugin):
+    status = "photographed"
+
+    def after_place(self, sherd):
+        b = self.batch
+        standby = b.config["arm"]["standby"]
+        b.move_down(standby[0], standby[1], b.config["arm"]["travel_z"], sherd.grasp_yaw)
+        with b.phase("data_collection"):
+            try:
+                spool = b.archive.spool_path(b.context, sherd.seq)
+                capture = b.rig.camera.capture(spool)
+            except RigError as e:
+                b.event(sherd, "capture_failed", e.reason)
+                return "failed"
+            path, sha256 = b.archive.store(b.context, sherd.seq, capture.path, sherd.record())
+        b.recorder.record(b.context, sherd.seq, status=self.status, image_path=path,
+                          image_sha256=sha256)
+        return "done"
+
+
+@station_type("discard")
+class DiscardStation(StationPlugin):
+    status = "done"
+    release_from_above = True
+
+    def after_place(self, sherd):
+        self.batch.recorder.record(self.batch.context, sherd.seq, status=self.status,
+                                   drops=sherd.drops, timings=sherd.timings.as_dict())
+        return "done"

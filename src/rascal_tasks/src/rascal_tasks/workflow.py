@@ -1,0 +1,510 @@
+"""The station workflow: one bag's sherds, each picked, carried through the stations and recorded.
+
+    HOME -> CALIBRATE -> RESUME -> SURVEY -> PICKUP -> [TRANSLATE -> PLACE -> <station> -> REPICK]*
+         -> SURVEY ... -> PARK (when the pickup area stays empty)
+
+The per-station states are generated from the config's station list (`stations.py` holds the
+plug-ins). Every measurement is written when taken, and the row's status moves picked ->
+weighed -> photographed -> done | lost, so a restart of the same context resumes the sherd that
+was in progress instead of numbering it again. No ROS here: the rig, recorder, archive and
+progress callback are injected.
+"""
+import contextlib
+import math
+from dataclasses import dataclass, field
+from typing import Callable, List, Optional
+
+from rascal_tasks.rig import Observation, Rig, RigError, Timings
+from rascal_tasks.stations import STATION_PLUGINS
+from rascal_tasks.survey import lawnmower
+
+try:  # a rig with real smach uses it; ours has the same names and semantics
+    import smach
+except ImportError:  # pragma: no cover - depends on the machine
+    from rascal_tasks import smach
+
+# Wrist camera offset from ee_gripper_link when the gripper points down, along the gripper's
+# yaw direction: camera_link sits 0.055 m "above" gripper_link (rascal_description URDF).
+CAMERA_OFFSET = 0.055
+# Finger opening limits between the fingertips (facts §1.4: 30..74 mm).
+MIN_OPENING, MAX_OPENING = 0.030, 0.074
+# Two detections closer than this are the same sherd seen from two survey poses.
+SAME_SHERD = 0.02
+
+
+@dataclass
+class SherdInProgress:
+    seq: int
+    observation: Observation
+    grasp_yaw: float
+    grasp_height: float  # ee height above the surface when closing
+    width: float  # sherd width across the fingers (m)
+    station_index: int = -1  # last station done (-1: just picked)
+    where: str = "pickup"  # station it was last seen at
+    last_xy: tuple = (0.0, 0.0)
+    drops: int = 0
+    mass: Optional[float] = None
+    timings: Timings = field(default_factory=Timings)
+
+    def record(self) -> dict:
+        o = self.observation
+        return {"seq": self.seq, "length_m": o.length, "width_m": o.width,
+                "thickness_m": o.height, "colour_rgb": list(o.colour), "mass_kg": self.mass}
+
+
+class BatchAborted(Exception):
+    pass
+
+
+class Batch:
+    """Everything the states share: config, rig, recorder, archive, and the sherd in hand."""
+
+    def __init__(self, config, rig: Rig, recorder, archive, context: str,
+                 progress: Optional[Callable[[str], None]] = None, log=None):
+        self.config = config
+        self.rig = rig
+        self.recorder = recorder
+        self.archive = archive
+        self.context = context
+        self.progress = progress or (lambda state: None)
+        self.log = log or (lambda msg: None)
+        self.sherd: Optional[SherdInProgress] = None
+        self.pending: List[Observation] = []
+        self.empty_surveys = 0
+        self.completed = 0
+        self.lost = 0
+        self.started = rig.clock.now()
+        self.station_names = config.station_order()
+        self.plugins = [STATION_PLUGINS[config.stations[n].type](config.stations[n], self)
+                        for n in self.station_names]
+        self.pickup = next(s for s in config.stations.values() if s.type == "pickup")
+
+    # -- helpers used by states and plug-ins ----------------------------------------------------
+    @contextlib.contextmanager
+    def phase(self, name: str):
+        t0 = self.rig.clock.now()
+        try:
+            yield
+        finally:
+            if self.sherd is not None:
+                self.sherd.timings.add(name, self.rig.clock.now() - t0)
+
+    def event(self, sherd, kind: str, detail: str = ""):
+        self.log("%s %s: %s" % ("sherd %d" % sherd.seq if sherd else "batch", kind, detail))
+        self.recorder.event(self.context, sherd.seq if sherd else None, kind, detail)
+
+    def move_down(self, x, y, z, yaw, linear=False):
+        with self.phase("locomotion"):
+            self.rig.arm.move_down(x, y, z, yaw, linear=linear)
+
+    def survey_at(self, station, x, y) -> List[Observation]:
+        """Put the wrist camera over (x, y) of a station and detect what is there."""
+        yaw = math.atan2(y, x)
+        ex, ey = x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw)
+        self.move_down(ex, ey, station.surface_z + self.config["survey"]["z"], yaw)
+        with self.phase("perception"):
+            self.rig.clock.sleep(self.config["survey"]["settle_time"])
+            return self.rig.perception.detect(station.name)
+
+    def travel_z(self) -> float:
+        return self.config["arm"]["travel_z"]
+
+    def per_sherd(self) -> float:
+        done = self.completed + self.lost
+        return (self.rig.clock.now() - self.started) / done if done else 0.0
+
+
+def opening_for(width: float, margin: float) -> float:
+    return min(MAX_OPENING, max(MIN_OPENING, width + margin))
+
+
+def _merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
+    for o in new:
+        if all(o.distance_to(p.x, p.y) > SAME_SHERD for p in found):
+            found.append(o)
+    return found
+
+
+class BatchState(smach.State):
+    """A state with the batch at hand; checks for preemption between rig calls."""
+
+    def __init__(self, batch: Batch, outcomes):
+        smach.State.__init__(self, outcomes=list(outcomes) + ["preempted", "aborted"])
+        self.batch = batch
+
+    def execute(self, userdata):
+        self.batch.progress(self.label())
+        if self.preempt_requested():
+            self.service_preempt()
+            return "preempted"
+        try:
+            return self.run()
+        except RigError as e:
+            if e.code == "PREEMPTED" or self.preempt_requested():
+                self.service_preempt()
+                return "preempted"
+            self.batch.event(self.batch.sherd, "rig_error", str(e))
+            return "aborted"
+
+    def label(self) -> str:
+        return type(self).__name__
+
+    def run(self) -> str:
+        raise NotImplementedError
+
+
+class Home(BatchState):
+    def __init__(self, batch):
+        super().__init__(batch, ["done"])
+
+    def run(self):
+        b = self.batch
+        with b.phase("grasping"):
+            b.rig.gripper.open()
+        b.move_down(*b.pickup.area.center, b.travel_z(), 0.0)
+        return "done"
+
+
+class Calibrate(BatchState):
+    """Learn each station's background from an image of it. The pickup area is full of sherds,
+    so its background (the same mat) is learnt where the discard box's mat shows."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["done"])
+
+    def run(self):
+        b = self.batch
+        for st in b.config.stations.values():
+            if st.type == "pickup":
+                continue
+            yaw = math.atan2(st.place_at[1], st.place_at[0])
+            x, y = st.place_at
+            b.move_down(x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw),
+                        st.surface_z + b.config["survey"]["z"], yaw)
+            b.rig.perception.calibrate(st.name)
+            if st.type == "discard":
+                b.rig.perception.calibrate(b.pickup.name)
+        return "done"
+
+
+class Resume(BatchState):
+    """After a restart: find the sherd a killed run left unfinished and carry on with it.
+
+    Outcomes name the state to go on with: TRANSLATE_k (it is still in the gripper),
+    STATION_i (it lies placed at station i, not yet measured there), REPICK_i (it lies at
+    station i, measured), or SURVEY (nothing unfinished, or it is lost)."""
+
+    def __init__(self, batch):
+        n = len(batch.plugins)
+        super().__init__(batch, ["SURVEY"] + ["%s_%d" % (k, i) for i in range(n)
+                                              for k in ("TRANSLATE", "STATION")]
+                         + ["REPICK_%d" % i for i in range(n - 1)])
+
+    def run(self):
+        b = self.batch
+        rows = b.recorder.unfinished(b.context)
+        if not rows:
+            return "SURVEY"
+        seq, status = rows[0]
+        statuses = [p.status for p in b.plugins]
+        done = statuses.index(status) if status in statuses else -1
+        b.event(None, "resume", "sherd %d was %s" % (seq, status))
+        if b.rig.gripper.holding():
+            width = b.rig.gripper.width()
+            o = Observation(0, 0, 0, width, width, 0.0, 0, 0, 0, 0, width)
+            b.sherd = SherdInProgress(seq, o, 0.0, 0.01, width, station_index=done)
+            return "TRANSLATE_%d" % (done + 1)
+        for i in range(max(done, 0), len(b.plugins)):
+            st = b.plugins[i].station
+            if b.plugins[i].release_from_above:
+                break
+            seen = b.survey_at(st, *st.place_at)
+            if seen:
+                o = seen[0]
+                b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - st.surface_z,
+                                          o.width, station_index=done, where=st.name,
+                                          last_xy=(o.x, o.y))
+                return ("REPICK_%d" if i == done else "STATION_%d") % i
+        b.recorder.lost(b.context, seq, "not found after restart (was %s)" % status)
+        b.lost += 1
+        return "SURVEY"
+
+
+class Survey(BatchState):
+    def __init__(self, batch):
+        super().__init__(batch, ["found", "empty"])
+
+    def run(self):
+        b = self.batch
+        found: List[Observation] = []
+        for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size,
+                              b.config["survey"]["step"]):
+            _merge(found, b.survey_at(b.pickup, x, y))
+        if not found:
+            b.empty_surveys += 1
+            if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
+                return "empty"
+            return self.run()
+        b.empty_surveys = 0
+        policy = b.config["perception"]["selection_policy"]
+        if policy == "largest":
+            found.sort(key=lambda o: -o.length * o.width)
+        else:  # nearest first: shortest reach, least time; perception's order breaks ties
+            found.sort(key=lambda o: math.hypot(o.x, o.y))
+        b.pending = found
+        return "found"
+
+
+class Pickup(BatchState):
+    """Pick the next sherd from the pickup area; number it once it is in the gripper."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["held", "missed"])
+
+    def run(self):
+        b = self.batch
+        o = b.pending.pop(0)
+        attempts = b.config["recovery"]["max_grasp_attempts"]
+        for attempt in range(attempts):
+            if grasp(b, o, b.pickup.surface_z):
+                seq = b.recorder.new_sherd(b.context)
+                b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - b.pickup.surface_z,
+                                          o.width, last_xy=(o.x, o.y))
+                b.recorder.record(b.context, seq, length=o.length, width=o.width,
+                                  thickness=o.height, colour=o.colour)
+                return "held"
+            seen = b.survey_at(b.pickup, o.x, o.y)
+            near = [s for s in seen if s.distance_to(o.x, o.y) < b.config["recovery"][
+                "search_radius"]]
+            if not near:
+                break
+            o = min(near, key=lambda s: s.distance_to(o.x, o.y))
+        b.pending = []  # the area changed under us: survey again
+        return "missed"
+
+
+def grasp(b: Batch, o: Observation, surface_z: float) -> bool:
+    margin = b.config["arm"]["grasp_margin"]
+    with b.phase("grasping"):
+        b.rig.gripper.open(opening_for(o.grasp_width, margin))
+    approach = o.grasp_z + b.config["arm"]["approach_offset"]
+    b.move_down(o.grasp_x, o.grasp_y, approach, o.grasp_yaw)
+    b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)
+    with b.phase("grasping"):
+        held = b.rig.gripper.close().holding
+    b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
+    if held and not b.rig.gripper.holding():
+        held = False  # slipped out while lifting
+    if not held:
+        with b.phase("grasping"):
+            b.rig.gripper.open(opening_for(o.grasp_width, margin))
+    return held
+
+
+class Translate(BatchState):
+    """Carry the sherd to a station at travel height; a drop on the way goes to RECOVER."""
+
+    def __init__(self, batch, index):
+        super().__init__(batch, ["arrived", "dropped"])
+        self.index = index
+
+    def label(self):
+        return "Translate→%s" % self.batch.station_names[self.index]
+
+    def run(self):
+        b = self.batch
+        st = b.config.stations[b.station_names[self.index]]
+        b.move_down(*st.place_at, b.travel_z(), b.sherd.grasp_yaw)
+        if not b.rig.gripper.holding():
+            return dropped(b, "while carrying to %s" % st.name)
+        return "arrived"
+
+
+def dropped(b: Batch, where: str) -> str:
+    b.sherd.drops += 1
+    b.event(b.sherd, "dropped", where)
+    b.recorder.record(b.context, b.sherd.seq, drops=b.sherd.drops)
+    return "dropped"
+
+
+class Place(BatchState):
+    def __init__(self, batch, index):
+        super().__init__(batch, ["placed"])
+        self.index = index
+
+    def label(self):
+        return "Place@%s" % self.batch.station_names[self.index]
+
+    def run(self):
+        b = self.batch
+        plugin = b.plugins[self.index]
+        st = plugin.station
+        s = b.sherd
+        plugin.before_place(s)
+        if not plugin.release_from_above:
+            z = st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
+            b.move_down(*st.place_at, z, s.grasp_yaw, linear=True)
+        with b.phase("grasping"):
+            b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
+        if not plugin.release_from_above:
+            b.move_down(*st.place_at, b.travel_z(), s.grasp_yaw, linear=True)
+        s.where, s.last_xy = st.name, st.place_at
+        return "placed"
+
+
+class AtStation(BatchState):
+    """Runs the station plug-in (weigh, photograph, discard) and records what it measured."""
+
+    def __init__(self, batch, index):
+        super().__init__(batch, ["done"])
+        self.index = index
+
+    def label(self):
+        return "At %s" % self.batch.station_names[self.index]
+
+    def run(self):
+        b = self.batch
+        outcome = b.plugins[self.index].after_place(b.sherd)
+        if outcome != "done":
+            b.event(b.sherd, "station_failed", b.station_names[self.index])
+        b.sherd.station_index = self.index
+        if self.index == len(b.plugins) - 1:
+            b.completed += 1
+            b.sherd = None
+        return "done"
+
+
+class Repick(BatchState):
+    """Pick the sherd up again where it was placed; re-detect it if the blind grasp misses."""
+
+    def __init__(self, batch, index):
+        super().__init__(batch, ["held", "lost"])
+        self.index = index
+
+    def label(self):
+        return "Repick@%s" % self.batch.station_names[self.index]
+
+    def run(self):
+        b = self.batch
+        s = b.sherd
+        st = b.config.stations[b.station_names[self.index]]
+        x, y = s.last_xy
+        blind = Observation(x, y, s.grasp_yaw, s.observation.length, s.width, 0.0, x, y,
+                            st.surface_z + s.grasp_height, s.grasp_yaw,
+                            opening_for(s.width, b.config["arm"]["grasp_margin"]))
+        o = blind
+        for attempt in range(b.config["recovery"]["max_grasp_attempts"]):
+            if grasp(b, o, st.surface_z):
+                return "held"
+            seen = b.survey_at(st, x, y)
+            if not seen:
+                break
+            o = seen[0]
+            s.grasp_yaw, s.width = o.grasp_yaw, o.width
+            s.grasp_height = o.grasp_z - st.surface_z
+        return lose(b, "could not pick it up again at %s" % st.name)
+
+
+def lose(b: Batch, reason: str) -> str:
+    b.event(b.sherd, "lost", reason)
+    b.recorder.lost(b.context, b.sherd.seq, reason)
+    b.lost += 1
+    b.sherd = None
+    return "lost"
+
+
+class Recover(BatchState):
+    """A dropped sherd: look where it was last seen, then around the pickup area."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["held", "lost"])
+
+    def run(self):
+        b = self.batch
+        s = b.sherd
+        rec = b.config["recovery"]
+        if s.drops > rec["max_searches"]:
+            return lose(b, "dropped %d times" % s.drops)
+        where = b.config.stations.get(s.where, b.pickup)
+        candidates = b.survey_at(where, *s.last_xy)
+        if not candidates and where is not b.pickup:
+            candidates = b.survey_at(b.pickup, *b.pickup.area.center)
+            where = b.pickup
+        if not candidates:
+            return lose(b, "not found where it was last seen (%s)" % s.where)
+        o = min(candidates, key=lambda c: c.distance_to(*s.last_xy))
+        if grasp(b, o, where.surface_z):
+            s.grasp_yaw, s.width = o.grasp_yaw, o.width
+            s.grasp_height = o.grasp_z - where.surface_z
+            return "held"
+        return lose(b, "found but could not be picked up")
+
+
+class Park(BatchState):
+    def __init__(self, batch):
+        super().__init__(batch, ["done"])
+
+    def execute(self, userdata):  # parks even when preempted
+        try:
+            park(self.batch)
+        except RigError as e:
+            self.batch.event(None, "park_failed", str(e))
+            return "aborted"
+        return "done"
+
+
+def park(b: Batch):
+    b.rig.arm.go("sleep")
+
+
+def build_machine(batch: Batch):
+    """The state machine for one batch; outcomes: finished, preempted, aborted."""
+    sm = smach.StateMachine(outcomes=["finished", "preempted", "aborted"])
+    n = len(batch.plugins)
+    fail = {"preempted": "PARK_PREEMPTED", "aborted": "PARK_ABORTED"}
+
+    def next_after(i):
+        return "TRANSLATE_%d" % (i + 1) if i + 1 < n else "SURVEY"
+
+    with sm:
+        smach.StateMachine.add("HOME", Home(batch), dict(done="CALIBRATE", **fail))
+        smach.StateMachine.add("CALIBRATE", Calibrate(batch), dict(done="RESUME", **fail))
+        resume = Resume(batch)
+        smach.StateMachine.add("RESUME", resume, dict(
+            {o: o for o in resume.get_registered_outcomes()
+             if o not in ("preempted", "aborted")}, **fail))
+        smach.StateMachine.add("SURVEY", Survey(batch), dict(found="PICKUP", empty="PARK", **fail))
+        smach.StateMachine.add("PICKUP", Pickup(batch),
+                               dict(held="TRANSLATE_0", missed="SURVEY", **fail))
+        for i in range(n):
+            last = i == n - 1
+            smach.StateMachine.add("TRANSLATE_%d" % i, Translate(batch, i),
+                                   dict(arrived="PLACE_%d" % i, dropped="RECOVER_%d" % i, **fail))
+            smach.StateMachine.add("PLACE_%d" % i, Place(batch, i),
+                                   dict(placed="STATION_%d" % i, **fail))
+            smach.StateMachine.add("STATION_%d" % i, AtStation(batch, i),
+                                   dict(done="SURVEY_NEXT" if last else "REPICK_%d" % i, **fail))
+            if not last:
+                smach.StateMachine.add("REPICK_%d" % i, Repick(batch, i),
+                                       dict(held=next_after(i), lost="SURVEY_NEXT", **fail))
+            smach.StateMachine.add("RECOVER_%d" % i, Recover(batch),
+                                   dict(held="TRANSLATE_%d" % i, lost="SURVEY_NEXT", **fail))
+        smach.StateMachine.add("SURVEY_NEXT", _Next(batch),
+                               dict(pickup="PICKUP", survey="SURVEY", **fail))
+        smach.StateMachine.add("PARK", Park(batch), dict(done="finished", aborted="aborted",
+                                                         preempted="preempted"))
+        smach.StateMachine.add("PARK_PREEMPTED", Park(batch),
+                               dict(done="preempted", aborted="aborted", preempted="preempted"))
+        smach.StateMachine.add("PARK_ABORTED", Park(batch),
+                               dict(done="aborted", aborted="aborted", preempted="aborted"))
+    return sm
+
+
+class _Next(BatchState):
+    """After a sherd: take the next one already seen, or survey again."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["pickup", "survey"])
+
+    def run(self):
+        return "pickup" if self.batch.pending else "survey"
