@@ -1,0 +1,65 @@
+// Plans joint-space and straight-line Cartesian moves of the arm as time-optimal trajectories under
+// joint speed and acceleration limits, and refuses motions that would hit a fixture.
+#pragma once
+
+#include <string>
+
+#include <kdl/frames.hpp>
+
+#include "rascal_control/CollisionChecker.hpp"
+#include "rascal_control/IkSolver.hpp"
+#include "rascal_control/KinematicModel.hpp"
+#include "rascal_control/Trajectory.hpp"
+
+namespace rascal_control {
+
+// Same values as rascal_msgs/MoveArm's result codes.
+enum class PlanCode { Ok = 0, Unreachable = 1, Collision = 2, InvalidGoal = 5 };
+
+struct PlanResult {
+  PlanCode code = PlanCode::InvalidGoal;
+  std::string message;
+  Trajectory trajectory;
+  bool ok() const { return code == PlanCode::Ok; }
+};
+
+class TrajectoryPlanner {
+ public:
+  struct Options {
+    double max_acceleration = 5.0;  // [rad/s^2] every arm joint (facts/timing.md)
+    double linear_step = 0.005;     // [m] Cartesian waypoint spacing of linear moves
+    double angular_step = 0.05;     // [rad] orientation change between waypoints
+    double max_joint_step = 0.25;   // [rad] larger jumps between waypoints = not a continuous path
+    double line_tolerance = 0.0005; // [m] the planned joint path stays this close to the line
+    double collision_step = 0.01;   // [rad] joint change between collision samples
+  };
+
+  // `collisions` may be null (no checking). The model, solver and checker must outlive the planner.
+  TrajectoryPlanner(const KinematicModel& model, IkSolver& ik, const CollisionChecker* collisions);
+  TrajectoryPlanner(const KinematicModel& model, IkSolver& ik, const CollisionChecker* collisions,
+                    const Options& options);
+
+  // Synchronised rest-to-rest move along the joint-space line: the trapezoid of the slowest joint.
+  // speed_scale in (0, 1] scales the speed and acceleration limits.
+  PlanResult planJoint(const JointVector& start, const JointVector& goal, double speed_scale) const;
+  // ee_gripper_link along the straight line (orientation interpolated) from FK(start) to `goal`.
+  PlanResult planLinear(const JointVector& start, const KDL::Frame& goal, double speed_scale);
+
+  // Scales a trajectory's time so that it stays inside the limits (samples every `dt`);
+  // returns the factor used (1 = unchanged).
+  double enforceLimits(Trajectory& trajectory, double speed_scale, double dt = 0.001) const;
+
+  const Options& options() const { return options_; }
+
+ private:
+  bool validStart(const JointVector& start, double speed_scale, PlanResult& result) const;
+  bool collisionFree(const JointPath& path, PlanResult& result) const;
+  TimeScaling timeOptimal(const JointPath& path, double speed_scale) const;
+
+  const KinematicModel& model_;
+  IkSolver& ik_;
+  const CollisionChecker* collisions_;
+  Options options_;
+};
+
+}  // namespace rascal_control

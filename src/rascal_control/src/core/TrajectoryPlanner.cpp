@@ -1,0 +1,288 @@
+#include "rascal_control/TrajectoryPlanner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+namespace rascal_control {
+
+namespace {
+
+constexpr double kStartTolerance = 0.05;   // [rad] a measured start may sit this far past a limit
+constexpr double kVelocityMargin = 0.995;  // planning margins; enforceLimits() checks the truth
+constexpr double kAccelerationMargin = 0.98;
+constexpr int kGridPerSegment = 8;
+constexpr int kMinGrid = 64;
+constexpr int kMaxRefinements = 3;
+
+std::string vectorText(const KDL::Vector& v) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "(%.3f, %.3f, %.3f)", v.x(), v.y(), v.z());
+  return text;
+}
+
+// Distance from p to the segment a-b.
+double distanceToSegment(const KDL::Vector& p, const KDL::Vector& a, const KDL::Vector& b) {
+  const KDL::Vector ab = b - a;
+  const double len2 = KDL::dot(ab, ab);
+  double t = len2 > 0.0 ? KDL::dot(p - a, ab) / len2 : 0.0;
+  t = std::min(1.0, std::max(0.0, t));
+  return (p - (a + ab * t)).Norm();
+}
+
+}  // namespace
+
+TrajectoryPlanner::TrajectoryPlanner(const KinematicModel& model, IkSolver& ik,
+                                     const CollisionChecker* collisions)
+    : TrajectoryPlanner(model, ik, collisions, Options()) {}
+
+TrajectoryPlanner::TrajectoryPlanner(const KinematicModel& model, IkSolver& ik,
+                                     const CollisionChecker* collisions, const Options& options)
+    : model_(model), ik_(ik), collisions_(collisions), options_(options) {}
+
+bool TrajectoryPlanner::validStart(const JointVector& start, double speed_scale,
+                                   PlanResult& result) const {
+  if (!(speed_scale > 0.0 && speed_scale <= 1.0)) {
+    result.code = PlanCode::InvalidGoal;
+    result.message = "speed scale " + std::to_string(speed_scale) + " is outside (0, 1]";
+    return false;
+  }
+  for (double q : start) {
+    if (!std::isfinite(q)) {
+      result.code = PlanCode::InvalidGoal;
+      result.message = "start joint vector is not finite";
+      return false;
+    }
+  }
+  const int joint = model_.firstLimitViolation(start, kStartTolerance);
+  if (joint >= 0) {
+    result.code = PlanCode::InvalidGoal;
+    result.message = "start position of " + KinematicModel::armJointNames()[joint] + " (" +
+                     std::to_string(start[joint]) + " rad) is outside its limits";
+    return false;
+  }
+  return true;
+}
+
+bool TrajectoryPlanner::collisionFree(const JointPath& path, PlanResult& result) const {
+  if (collisions_ == nullptr) {
+    return true;
+  }
+  const auto hit = collisions_->check(path, options_.collision_step);
+  if (!hit) {
+    return true;
+  }
+  const KDL::Frame tip = model_.forward(hit->q);
+  char text[64];
+  std::snprintf(text, sizeof(text), " at %.0f %% of the path", hit->s * 100.0);
+  result.code = PlanCode::Collision;
+  result.message = hit->link + " would hit the " + hit->fixture + text + " (gripper at " +
+                   vectorText(tip.p) + ")";
+  return false;
+}
+
+PlanResult TrajectoryPlanner::planJoint(const JointVector& start, const JointVector& goal,
+                                        double speed_scale) const {
+  PlanResult result;
+  if (!validStart(start, speed_scale, result)) {
+    return result;
+  }
+  for (std::size_t j = 0; j < kArmJoints; ++j) {
+    if (!std::isfinite(goal[j]) || goal[j] < model_.limits()[j].lower ||
+        goal[j] > model_.limits()[j].upper) {
+      result.code = PlanCode::InvalidGoal;
+      char text[128];
+      std::snprintf(text, sizeof(text), "goal %s = %.4f rad is outside its limits [%.4f, %.4f]",
+                    KinematicModel::armJointNames()[j].c_str(), goal[j], model_.limits()[j].lower,
+                    model_.limits()[j].upper);
+      result.message = text;
+      return result;
+    }
+  }
+  // Rest-to-rest along the joint-space line: s(t) is the trapezoid whose speed and acceleration,
+  // multiplied by each joint's distance, meet the tightest joint's limits.
+  double sd_max = std::numeric_limits<double>::infinity();
+  double sdd_max = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < kArmJoints; ++j) {
+    const double d = std::fabs(goal[j] - start[j]);
+    if (d > 1e-12) {
+      sd_max = std::min(sd_max, model_.limits()[j].velocity * speed_scale / d);
+      sdd_max = std::min(sdd_max, options_.max_acceleration * speed_scale / d);
+    }
+  }
+  JointPath path = JointPath::line(start, goal);
+  if (!std::isfinite(sd_max)) {
+    result.code = PlanCode::Ok;
+    result.message = "already there";
+    result.trajectory = Trajectory(path, TimeScaling::still());
+    return result;
+  }
+  if (!collisionFree(path, result)) {
+    return result;
+  }
+  result.code = PlanCode::Ok;
+  result.message = "ok";
+  result.trajectory = Trajectory(path, TimeScaling::trapezoid(sd_max, sdd_max));
+  return result;
+}
+
+PlanResult TrajectoryPlanner::planLinear(const JointVector& start, const KDL::Frame& goal,
+                                         double speed_scale) {
+  PlanResult result;
+  if (!validStart(start, speed_scale, result)) {
+    return result;
+  }
+  const KDL::Frame from = model_.forward(start);
+  const double length = (goal.p - from.p).Norm();
+  KDL::Vector axis;
+  const double angle = (from.M.Inverse() * goal.M).GetRotAngle(axis);
+  int n = std::max({1, static_cast<int>(std::ceil(length / options_.linear_step)),
+                    static_cast<int>(std::ceil(angle / options_.angular_step))});
+
+  for (int refinement = 0; refinement <= kMaxRefinements; ++refinement, n *= 2) {
+    std::vector<JointVector> knots{start};
+    for (int k = 1; k <= n; ++k) {
+      const double s = static_cast<double>(k) / n;
+      const KDL::Frame waypoint(from.M * KDL::Rotation::Rot2(axis, angle * s),
+                                from.p + (goal.p - from.p) * s);
+      const IkResult ik = ik_.solve(waypoint, knots.back());
+      if (!ik.ok()) {
+        result.code = ik.code == IkCode::Invalid ? PlanCode::InvalidGoal : PlanCode::Unreachable;
+        result.message = "linear move: waypoint " + std::to_string(k) + "/" + std::to_string(n) +
+                         " fails: " + ik.message;
+        return result;
+      }
+      for (std::size_t j = 0; j < kArmJoints; ++j) {
+        if (std::fabs(ik.joints[j] - knots.back()[j]) > options_.max_joint_step) {
+          result.code = PlanCode::Unreachable;
+          result.message = "linear move: the line from " + vectorText(from.p) + " to " +
+                           vectorText(goal.p) + " needs a jump of " +
+                           KinematicModel::armJointNames()[j] + " near " +
+                           vectorText(waypoint.p) + " (passes a singularity or a joint limit)";
+          return result;
+        }
+      }
+      knots.push_back(ik.joints);
+    }
+    JointPath path = JointPath::spline(knots);
+    // Between the waypoints the spline must stay on the line.
+    double worst = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double s = (static_cast<double>(k) + 0.5) / n;
+      worst = std::max(worst, distanceToSegment(model_.forward(path.at(s)).p, from.p, goal.p));
+    }
+    if (worst > options_.line_tolerance && refinement < kMaxRefinements) {
+      continue;
+    }
+    if (!collisionFree(path, result)) {
+      return result;
+    }
+    result.trajectory = Trajectory(path, timeOptimal(path, speed_scale));
+    enforceLimits(result.trajectory, speed_scale);
+    result.code = PlanCode::Ok;
+    result.message = "ok";
+    return result;
+  }
+  result.code = PlanCode::Unreachable;
+  result.message = "linear move: no joint path stays on the line";
+  return result;
+}
+
+TimeScaling TrajectoryPlanner::timeOptimal(const JointPath& path, double speed_scale) const {
+  const int m = std::max(kMinGrid, static_cast<int>(path.segments()) * kGridPerSegment);
+  const double ds = 1.0 / m;
+  std::vector<JointVector> dq(m + 1), ddq(m + 1);
+  JointVector v{}, a{};
+  for (std::size_t j = 0; j < kArmJoints; ++j) {
+    v[j] = model_.limits()[j].velocity * speed_scale * kVelocityMargin;
+    a[j] = options_.max_acceleration * speed_scale * kAccelerationMargin;
+  }
+  std::vector<double> grid(m + 1), x_max(m + 1);
+  for (int k = 0; k <= m; ++k) {
+    grid[k] = static_cast<double>(k) * ds;
+    JointVector q{};
+    path.evaluate(grid[k], q, dq[k], ddq[k]);
+  }
+  // Acceleration bounds u = d2s/dt2 at grid point k for x = (ds/dt)^2: |dq u + ddq x| <= a.
+  auto bounds = [&](int k, double x, double& lo, double& hi) {
+    lo = -std::numeric_limits<double>::infinity();
+    hi = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < kArmJoints; ++j) {
+      const double d = dq[k][j], dd = ddq[k][j];
+      if (std::fabs(d) < 1e-12) {
+        if (std::fabs(dd) * x > a[j]) {
+          lo = 1.0;
+          hi = -1.0;
+          return;
+        }
+        continue;
+      }
+      const double u1 = (-a[j] - dd * x) / d, u2 = (a[j] - dd * x) / d;
+      lo = std::max(lo, std::min(u1, u2));
+      hi = std::min(hi, std::max(u1, u2));
+    }
+  };
+  for (int k = 0; k <= m; ++k) {
+    double x_vel = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < kArmJoints; ++j) {
+      if (std::fabs(dq[k][j]) > 1e-12) {
+        x_vel = std::min(x_vel, std::pow(v[j] / std::fabs(dq[k][j]), 2));
+      }
+    }
+    if (!std::isfinite(x_vel)) {
+      x_vel = 1e6;
+    }
+    double lo = 0.0, hi = 0.0;
+    bounds(k, x_vel, lo, hi);
+    if (lo <= hi) {
+      x_max[k] = x_vel;
+      continue;
+    }
+    double good = 0.0, bad = x_vel;  // the feasible set of x is an interval [0, x*]
+    for (int it = 0; it < 50; ++it) {
+      const double mid = 0.5 * (good + bad);
+      bounds(k, mid, lo, hi);
+      (lo <= hi ? good : bad) = mid;
+    }
+    x_max[k] = good;
+  }
+  std::vector<double> x(m + 1, 0.0);
+  for (int k = 0; k < m; ++k) {  // forward: accelerate as hard as allowed
+    double lo = 0.0, hi = 0.0;
+    bounds(k, x[k], lo, hi);
+    x[k + 1] = std::min(x_max[k + 1], std::max(0.0, x[k] + 2.0 * ds * std::max(0.0, hi)));
+  }
+  x[m] = 0.0;
+  for (int k = m; k > 0; --k) {  // backward: brake in time
+    double lo = 0.0, hi = 0.0;
+    bounds(k, x[k], lo, hi);
+    x[k - 1] = std::min(x[k - 1], x[k] + 2.0 * ds * std::max(0.0, -lo));
+  }
+  x[0] = 0.0;
+  std::vector<double> sd(m + 1);
+  for (int k = 0; k <= m; ++k) {
+    sd[k] = (k == 0 || k == m) ? 0.0 : std::max(1e-6, std::sqrt(std::max(0.0, x[k])));
+  }
+  return TimeScaling::fromGrid(grid, sd);
+}
+
+double TrajectoryPlanner::enforceLimits(Trajectory& trajectory, double speed_scale, double dt) const {
+  double ratio_v = 0.0, ratio_a = 0.0;
+  const double total = trajectory.duration();
+  for (double t = 0.0; t <= total + dt; t += dt) {
+    const Trajectory::Sample sample = trajectory.sample(std::min(t, total));
+    for (std::size_t j = 0; j < kArmJoints; ++j) {
+      ratio_v = std::max(ratio_v, std::fabs(sample.qd[j]) / (model_.limits()[j].velocity * speed_scale));
+      ratio_a = std::max(ratio_a, std::fabs(sample.qdd[j]) / (options_.max_acceleration * speed_scale));
+    }
+  }
+  const double factor = std::max({1.0, ratio_v, std::sqrt(ratio_a)});
+  if (factor > 1.0) {
+    trajectory = Trajectory(trajectory.path(), trajectory.timing().stretched(factor * 1.001));
+  }
+  return factor;
+}
+
+}  // namespace rascal_control

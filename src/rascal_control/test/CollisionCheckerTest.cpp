@@ -1,0 +1,88 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "TestModel.hpp"
+#include "rascal_control/CollisionChecker.hpp"
+#include "rascal_control/TrajectoryPlanner.hpp"
+
+using namespace rascal_control;
+
+namespace {
+
+// The station fixtures of config/rascal.yaml.
+void addStations(CollisionChecker& checker) {
+  checker.addFixture({"camera stand", KDL::Vector(0.50, -0.30, 0.30), KDL::Vector(0.04, 0.04, 0.60), false});
+  checker.addOpenBox("discard box", 0.02, -0.31, 0.14, 0.13, 0.04, 0.004);
+  checker.addFixture({"scale", KDL::Vector(0.30, 0.0, 0.0125), KDL::Vector(0.13, 0.13, 0.025), true});
+}
+
+}  // namespace
+
+TEST(CollisionChecker, ChecksTheArmBodiesOfTheUrdf) {
+  CollisionChecker checker(testModel());
+  const auto links = checker.checkedLinks();
+  for (const char* link : {"upper_arm_link", "wrist_link", "gripper_link", "left_finger_link", "camera_link"}) {
+    EXPECT_NE(std::find(links.begin(), links.end(), link), links.end()) << link;
+  }
+  EXPECT_EQ(std::find(links.begin(), links.end(), "base_link"), links.end());
+}
+
+TEST(CollisionChecker, TableAndFixtures) {
+  CollisionChecker checker(testModel());
+  addStations(checker);
+  IkSolver ik(testModel());
+  EXPECT_FALSE(checker.check(JointVector{}));
+  EXPECT_FALSE(checker.check(JointVector{0, -1.80, 1.55, 0, 0.8, 0}));  // sleep
+  // Gripper pointing down with the wrist in the table.
+  IkResult r = ik.solve(IkSolver::topDown(0.25, 0.2, -0.06, 0.0), JointVector{});
+  ASSERT_TRUE(r.ok());
+  auto hit = checker.check(r.joints);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->fixture, "table");
+  // Fingertips on the table are allowed (picking flat sherds).
+  r = ik.solve(IkSolver::topDown(0.25, 0.2, 0.005, 0.0), JointVector{});
+  ASSERT_TRUE(r.ok());
+  EXPECT_FALSE(checker.check(r.joints)) << checker.check(r.joints)->link;
+  // The fingers down inside a discard wall (fingers along the wall).
+  r = ik.solve(IkSolver::topDown(0.02, -0.31 + 0.063, 0.03, M_PI / 2.0), JointVector{});
+  ASSERT_TRUE(r.ok());
+  hit = checker.check(r.joints);
+  ASSERT_TRUE(hit);
+  EXPECT_NE(hit->fixture.find("discard"), std::string::npos);
+}
+
+TEST(CollisionChecker, MoveThroughTheCameraStandIsRefused) {
+  IkSolver ik(testModel());
+  CollisionChecker checker(testModel());
+  addStations(checker);
+  TrajectoryPlanner planner(testModel(), ik, &checker);
+  // Gripper horizontal, pointing away from the base, moved sideways at x = 0.50 through the
+  // stand's post at (0.50, -0.30).
+  const KDL::Frame from(KDL::Rotation::RotZ(std::atan2(-0.15, 0.50)), KDL::Vector(0.50, -0.15, 0.12));
+  const KDL::Frame to(KDL::Rotation::RotZ(std::atan2(-0.42, 0.50)), KDL::Vector(0.50, -0.42, 0.12));
+  const IkResult start = ik.solve(from, JointVector{});
+  ASSERT_TRUE(start.ok()) << start.message;
+  PlanResult r = planner.planLinear(start.joints, to, 1.0);
+  EXPECT_EQ(r.code, PlanCode::Collision) << r.message;
+  EXPECT_NE(r.message.find("camera stand"), std::string::npos) << r.message;
+  const IkResult goal = ik.solve(to, start.joints);
+  ASSERT_TRUE(goal.ok());
+  r = planner.planJoint(start.joints, goal.joints, 1.0);
+  EXPECT_EQ(r.code, PlanCode::Collision) << r.message;
+  // Without the stand the same moves are fine.
+  CollisionChecker table_only(testModel());
+  TrajectoryPlanner free_planner(testModel(), ik, &table_only);
+  EXPECT_TRUE(free_planner.planLinear(start.joints, to, 1.0).ok());
+  EXPECT_TRUE(free_planner.planJoint(start.joints, goal.joints, 1.0).ok());
+}
+
+TEST(CollisionChecker, MovingAwayFromAnExistingContactIsAllowed) {
+  IkSolver ik(testModel());
+  CollisionChecker checker(testModel());
+  TrajectoryPlanner planner(testModel(), ik, &checker);
+  const IkResult low = ik.solve(IkSolver::topDown(0.25, 0.2, -0.06, 0.0), JointVector{});
+  ASSERT_TRUE(low.ok());
+  ASSERT_TRUE(checker.check(low.joints));
+  EXPECT_TRUE(planner.planLinear(low.joints, IkSolver::topDown(0.25, 0.2, 0.10, 0.0), 1.0).ok());
+}
