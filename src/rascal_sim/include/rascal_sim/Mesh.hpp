@@ -1,0 +1,30 @@
+#pragma once
+// A triangle mesh with one linear-RGB colour per triangle (what the renderer draws).
+#include <Eigen/Geometry>
+#include <array>
+#include <string>
+#include <vector>
+
+namespace rascal_sim {
+
+struct Mesh {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<Eigen::Vector3f> colours;  ///< linear RGB per triangle
+
+  void addTriangle(int a, int b, int c, const Eigen::Vector3f& linear_rgb);
+  /// Adds an axis-aligned box (centre, size) with one sRGB colour.
+  void addBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size, const Eigen::Vector3d& srgb);
+  /// Adds a flat rectangle at height z (centre x, y; size x, y) with one sRGB colour.
+  void addRect(double cx, double cy, double sx, double sy, double z, const Eigen::Vector3d& srgb);
+  /// Signed volume enclosed by a closed mesh [m^3] (absolute value returned).
+  double volume() const;
+  Eigen::Vector3d minCorner() const;
+  Eigen::Vector3d maxCorner() const;
+
+  static Eigen::Vector3f srgbToLinear(const Eigen::Vector3d& srgb);
+  /// Reads a binary or ASCII STL file (metres); throws std::runtime_error naming the file.
+  static Mesh loadStl(const std::string& path, const Eigen::Vector3d& srgb);
+};
+
+}  // namespace rascal_sim

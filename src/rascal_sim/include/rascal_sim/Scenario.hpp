@@ -1,0 +1,43 @@
+#pragma once
+// A scenario: the sherds on the table and the lighting, read from a YAML file.
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+namespace rascal_sim {
+
+struct SherdSpec {
+  std::string name;
+  std::vector<Eigen::Vector2d> outline;  ///< [m] polygon in the sherd frame (x = major axis)
+  double thickness = 0.007;              ///< [m] wall thickness
+  double curvature = 0.0;                ///< [1/m] bend across the sherd's width (vessel wall)
+  double curvature_long = 0.0;           ///< [1/m] bend along the sherd's length
+  bool convex_up = true;                 ///< outer vessel surface facing up
+  double density = 1850.0;               ///< [kg/m^3]
+  std::string munsell = "5YR 6/6";       ///< surface colour chip
+  Eigen::Vector3d colour{0.76, 0.52, 0.40};  ///< sRGB [0, 1], resolved from `munsell`
+  std::string pattern = "none";          ///< none | stripes | band (painted decoration)
+  Eigen::Vector3d pattern_colour{0.15, 0.10, 0.08};
+  std::string mesh_file;                 ///< optional STL (metres); replaces the outline shell
+  Eigen::Vector3d pose{0.0, 0.0, 0.0};   ///< [m, m, rad] x, y, yaw on the table
+  double drop_height = 0.0;              ///< [m] gap under the sherd when spawned
+};
+
+struct Lighting {
+  double brightness = 1.0;            ///< [1] 0.3 .. 1.5
+  double colour_temperature = 6500;   ///< [K] 2500 .. 10000; 6500 = neutral
+  double shadow_strength = 0.0;       ///< [1] fraction of light the shadow takes away, 0 .. 0.8
+  double shadow_radius = 0.08;        ///< [m]
+  Eigen::Vector2d shadow_start{0.0, 0.4};     ///< [m] shadow centre on the table at t = 0
+  Eigen::Vector2d shadow_velocity{0.0, -0.01};  ///< [m/s] it drifts across the table
+  double colour_noise = 2.0;          ///< [8-bit counts] sigma of the colour sensor noise
+};
+
+struct Scenario {
+  std::string name = "empty";
+  unsigned seed = 1;
+  Lighting lighting;
+  std::vector<SherdSpec> sherds;
+};
+
+}  // namespace rascal_sim

@@ -1,0 +1,40 @@
+#pragma once
+// Random scenarios: N irregular sherds on a station, seeded, spaced at least a finger apart.
+#include <Eigen/Geometry>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "rascal_sim/MunsellTable.hpp"
+#include "rascal_sim/Scenario.hpp"
+#include "rascal_sim/WorldLayout.hpp"
+
+namespace rascal_sim {
+
+struct GeneratorOptions {
+  int count = 10;
+  unsigned seed = 1;
+  TableRect area;                    ///< where the sherds go (normally the pickup mat)
+  double min_spacing = 0.012;        ///< [m] gap between neighbouring sherds (a finger's width)
+  int touching_pairs = 0;            ///< pairs of sherds pushed together until they touch
+  double length_min = 0.035, length_max = 0.070;  ///< [m] outline major axis
+  double width_min = 0.032, width_max = 0.050;    ///< [m] outline minor axis (>= 30 mm gripper)
+  double thickness_min = 0.004, thickness_max = 0.012;
+  double density_min = 1800.0, density_max = 2000.0;
+  double painted_fraction = 0.3;     ///< share of sherds with a painted pattern
+  int mesh_count = 0;                ///< how many sherds use the fragment STL instead
+  std::string mesh_file;
+};
+
+class ScenarioGenerator {
+ public:
+  explicit ScenarioGenerator(const MunsellTable& munsell);
+  std::vector<SherdSpec> generate(const GeneratorOptions& options) const;
+  /// An irregular outline with extents length x width, centred on its bounding box.
+  static std::vector<Eigen::Vector2d> irregularOutline(double length, double width, std::mt19937& rng);
+
+ private:
+  const MunsellTable& munsell_;
+};
+
+}  // namespace rascal_sim

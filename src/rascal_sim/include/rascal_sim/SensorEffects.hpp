@@ -1,0 +1,40 @@
+#pragma once
+// What the camera adds to the rendered radiance: scenario lighting (brightness, colour
+// temperature, a moving shadow), motion blur, colour noise, and the D435 depth noise model.
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <random>
+
+#include "rascal_sim/CameraModel.hpp"
+#include "rascal_sim/Scenario.hpp"
+
+namespace rascal_sim {
+
+class SensorEffects {
+ public:
+  static constexpr double kDepthFocal = 382.6;     ///< [px] D435 depth at 640 x 480, facts §4.3
+  static constexpr double kBaseline = 0.050;       ///< [m] facts §4.1
+  static constexpr double kSubpixelSigma = 0.08;   ///< [px] facts §4.4 (unverified figure)
+  static constexpr double kMinDepth = 0.105;       ///< [m] below this the D435 returns 0 (min-Z)
+
+  explicit SensorEffects(unsigned seed = 1);
+  /// White-balance gains of light at `kelvin` relative to 6500 K (sRGB primaries).
+  static Eigen::Vector3d temperatureGains(double kelvin);
+  /// sigma of the depth noise at distance z [m].
+  static double depthSigma(double z) { return z * z * kSubpixelSigma / (kDepthFocal * kBaseline); }
+
+  /// 8-bit sRGB image (CV_8UC3, RGB order) from rendered radiance and depth.
+  cv::Mat colourImage(const cv::Mat& radiance, const cv::Mat& depth, const CameraModel& camera,
+                      const Eigen::Isometry3d& world_T_camera, const Lighting& lighting, double t,
+                      double blur_px);
+  /// CV_16UC1 depth in mm with noise, quantisation, min-Z holes and the left invalid band.
+  cv::Mat depthImage(const cv::Mat& depth, const CameraModel& camera, bool left_band = true);
+
+ private:
+  std::mt19937 rng_;
+  std::vector<float> gauss_;  ///< a table of N(0, 1) samples, read from a random offset
+  float gauss();
+  size_t cursor_ = 0;
+};
+
+}  // namespace rascal_sim

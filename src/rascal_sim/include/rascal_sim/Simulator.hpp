@@ -1,0 +1,109 @@
+#pragma once
+// Everything the node drives: world physics, servos, gripper and grasp logic, scale, wrist and
+// archival cameras, faults and sim time. No ROS communication.
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "rascal_sim/ArchivalCamera.hpp"
+#include "rascal_sim/GripperModel.hpp"
+#include "rascal_sim/Renderer.hpp"
+#include "rascal_sim/ScaleSensor.hpp"
+#include "rascal_sim/Scenario.hpp"
+#include "rascal_sim/SensorEffects.hpp"
+#include "rascal_sim/ServoModel.hpp"
+#include "rascal_sim/World.hpp"
+
+namespace rascal_sim {
+
+struct SimulatorOptions {
+  double physics_dt = 0.001;                         ///< [s]
+  JointVector initial_joints{0.0, -1.80, 1.55, 0.0, 0.8, 0.0};  ///< sleep pose
+  double initial_finger = 0.037;                     ///< [m] open
+  bool wrist_camera = true;
+  double wrist_rate = 30.0;                          ///< [Hz]
+  CameraModel wrist_model = CameraModel::wristD435();
+  int archival_width = 2000, archival_height = 1500;
+};
+
+struct WristFrame {
+  double stamp = 0.0;
+  cv::Mat rgb;        ///< CV_8UC3, RGB order
+  cv::Mat depth_mm;   ///< CV_16UC1
+  Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
+  bool blurred = false;
+};
+
+enum class Fault { kDropNextGrasp = 0, kScaleGlitch = 1, kCameraTimeout = 2 };
+
+class Simulator {
+ public:
+  static constexpr double kBlurSpeed = 0.05;    ///< [rad/s] timing.md
+  static constexpr double kMaxPayload = 0.25;   ///< [kg] timing.md
+
+  Simulator(const WorldLayout& layout, const SimulatorOptions& options);
+  /// Spawns the scenario's sherds and takes its lighting; remembered for reset().
+  void load(const Scenario& scenario);
+  /// Re-spawns the last scenario and puts the arm back at its initial pose (time runs on).
+  void reset();
+  void step();
+  double time() const { return world_.time(); }
+
+  void commandArm(double start_time, const std::vector<TrajectoryPoint>& points,
+                  const std::array<bool, kArmJoints>& mask);
+  void commandGripper(double finger_position);
+  const JointVector& jointPositions() const { return servos_.positions(); }
+  const JointVector& jointVelocities() const { return servos_.velocities(); }
+  double fingerPosition() const { return gripper_.position(); }
+  double fingerVelocity() const { return gripper_.velocity(); }
+  bool armSettled() const { return servos_.settled(); }
+
+  /// True once per new 10 Hz scale reading.
+  bool takeScaleReading(ScaleReading& reading);
+  void tareScale() { scale_.tare(); }
+
+  bool wristFrameDue() const;
+  /// Renders the wrist camera at the present time and schedules the next frame.
+  WristFrame renderWristFrame();
+  Eigen::Isometry3d wristCameraPose() const;
+  const CameraModel& wristModel() const { return options_.wrist_model; }
+
+  ArchivalCamera& archival() { return archival_; }
+  /// Renders the archival view now (no noise budget for the shutter; used by the capture and tools).
+  cv::Mat renderArchival();
+  bool triggerCapture(std::string& why);
+
+  bool injectFault(int fault, double duration, std::string& message);
+  std::vector<SherdState> groundTruth() const;
+  World& world() { return world_; }
+  const Scenario& scenario() const { return scenario_; }
+  const SimulatorOptions& options() const { return options_; }
+
+ private:
+  void updateGrasp();
+
+  WorldLayout layout_;
+  SimulatorOptions options_;
+  World world_;
+  ServoModel servos_;
+  GripperModel gripper_;
+  ScaleSensor scale_;
+  ArchivalCamera archival_;
+  Renderer renderer_;
+  SensorEffects effects_;
+  Scenario scenario_;
+  std::mt19937 rng_;
+  double next_wrist_frame_ = 0.0;
+  bool scale_fresh_ = false;
+  bool drop_next_grasp_ = false;
+  double camera_fault_until_ = -1.0;
+  // grasp bookkeeping
+  double grasp_z_ = 0.0;
+  bool slip_armed_ = false;
+  double slip_delay_ = 0.0, slip_lifted_since_ = -1.0;
+  RenderOutput scratch_;
+  std::vector<RenderItem> items_;
+};
+
+}  // namespace rascal_sim

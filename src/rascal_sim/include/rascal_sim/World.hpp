@@ -1,0 +1,75 @@
+#pragma once
+// The ODE world: table, station fixtures, the scale platform as its own body, sherds, and the arm
+// as kinematic collision boxes that follow the servos.
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rascal_sim/ArmKinematics.hpp"
+#include "rascal_sim/Renderer.hpp"
+#include "rascal_sim/Scenario.hpp"
+#include "rascal_sim/WorldLayout.hpp"
+
+namespace rascal_sim {
+
+struct SherdState {
+  std::string name;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< body frame (box centre) in base_link
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  double mass = 0.0, thickness = 0.0, length = 0.0, width = 0.0;
+  Eigen::Vector3d box_size = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector2d> outline;  ///< in the body frame
+  Eigen::Vector3d colour = Eigen::Vector3d::Zero();
+  bool held = false;
+};
+
+/// Which sherd each finger touched in the last step (-1 = none) and how deep.
+struct FingerContacts {
+  int left = -1, right = -1;
+  double left_depth = 0.0, right_depth = 0.0;
+};
+
+class World {
+ public:
+  explicit World(const WorldLayout& layout);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  /// Replaces all sherds (throws std::runtime_error for a bad spec, naming the sherd).
+  void spawn(const std::vector<SherdSpec>& sherds);
+  void clearSherds();
+  /// Puts the arm at q / finger at once (start-up and reset).
+  void placeArm(const JointVector& q, double finger);
+  /// The arm pose the kinematic links must reach at the end of the next step.
+  void setArmTarget(const JointVector& q, double finger);
+  void step(double dt);
+  double time() const { return time_; }
+
+  /// Load on the scale platform [kg] from its support force over the last step.
+  double scaleLoad() const;
+  const FingerContacts& fingerContacts() const;
+  /// Fixes sherd i to the gripper (ODE fixed joint) / lets it go.
+  void hold(int sherd);
+  void release();
+  int held() const;
+  /// Fingers and gripper pass through sherd i until `until` (a slipping sherd falls out).
+  void ignoreGripperContacts(int sherd, double until);
+
+  size_t sherdCount() const;
+  SherdState sherd(size_t i) const;
+  const std::array<Eigen::Isometry3d, kArmLinkCount>& armPose() const;
+  /// Everything the cameras see (fixtures, sherds and, if asked, the arm links).
+  void renderItems(std::vector<RenderItem>& items, bool include_arm = true) const;
+  const WorldLayout& layout() const { return layout_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  WorldLayout layout_;
+  double time_ = 0.0;
+};
+
+}  // namespace rascal_sim

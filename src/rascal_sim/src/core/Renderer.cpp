@@ -1,0 +1,116 @@
+#include "rascal_sim/Renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rascal_sim {
+
+namespace {
+struct ClipVertex {
+  Eigen::Vector3d p;  // camera frame
+};
+
+struct Target {
+  cv::Mat* radiance;
+  cv::Mat* depth;
+  cv::Mat* label;
+};
+
+void rasterTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                    const CameraModel& cam, const Eigen::Vector3f& colour, int id, Target& t) {
+  const double ua = cam.fx * a.x() / a.z() + cam.cx, va = cam.fy * a.y() / a.z() + cam.cy;
+  const double ub = cam.fx * b.x() / b.z() + cam.cx, vb = cam.fy * b.y() / b.z() + cam.cy;
+  const double uc = cam.fx * c.x() / c.z() + cam.cx, vc = cam.fy * c.y() / c.z() + cam.cy;
+  const double area = (ub - ua) * (vc - va) - (vb - va) * (uc - ua);
+  if (std::abs(area) < 1e-12) return;
+  const int x0 = std::max(0, static_cast<int>(std::ceil(std::min({ua, ub, uc}))));
+  const int x1 = std::min(cam.width - 1, static_cast<int>(std::floor(std::max({ua, ub, uc}))));
+  const int y0 = std::max(0, static_cast<int>(std::ceil(std::min({va, vb, vc}))));
+  const int y1 = std::min(cam.height - 1, static_cast<int>(std::floor(std::max({va, vb, vc}))));
+  if (x0 > x1 || y0 > y1) return;
+  const double inv_area = 1.0 / area;
+  const double iza = 1.0 / a.z(), izb = 1.0 / b.z(), izc = 1.0 / c.z();
+  // barycentric weights as affine functions of (x, y)
+  const double w0x = (vb - vc) * inv_area, w0y = (uc - ub) * inv_area;
+  const double w1x = (vc - va) * inv_area, w1y = (ua - uc) * inv_area;
+  const double w0c = ((ub - x0) * (vc - y0) - (vb - y0) * (uc - x0)) * inv_area;
+  const double w1c = ((uc - x0) * (va - y0) - (vc - y0) * (ua - x0)) * inv_area;
+  const cv::Vec3f col(colour.x(), colour.y(), colour.z());
+  const double eps = -1e-9;
+  for (int y = y0; y <= y1; ++y) {
+    double w0 = w0c + w0y * (y - y0);
+    double w1 = w1c + w1y * (y - y0);
+    float* drow = t.depth->ptr<float>(y);
+    cv::Vec3f* crow = t.radiance->ptr<cv::Vec3f>(y);
+    uint16_t* lrow = t.label->ptr<uint16_t>(y);
+    for (int x = x0; x <= x1; ++x, w0 += w0x, w1 += w1x) {
+      const double w2 = 1.0 - w0 - w1;
+      if (w0 < eps || w1 < eps || w2 < eps) continue;
+      const double iz = w0 * iza + w1 * izb + w2 * izc;
+      if (iz <= 0) continue;
+      const float z = static_cast<float>(1.0 / iz);
+      if (drow[x] != 0.0f && z >= drow[x]) continue;
+      drow[x] = z;
+      crow[x] = col;
+      lrow[x] = static_cast<uint16_t>(id);
+    }
+  }
+}
+}  // namespace
+
+void Renderer::render(const std::vector<RenderItem>& items, const CameraModel& cam,
+                      const Eigen::Isometry3d& world_T_camera, RenderOutput& out) const {
+  out.radiance.create(cam.height, cam.width, CV_32FC3);
+  out.radiance.setTo(cv::Scalar::all(0));
+  out.depth.create(cam.height, cam.width, CV_32FC1);
+  out.depth.setTo(cv::Scalar::all(0));
+  out.label.create(cam.height, cam.width, CV_16UC1);
+  out.label.setTo(cv::Scalar::all(0));
+  Target target{&out.radiance, &out.depth, &out.label};
+  const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
+  const Eigen::Vector3d light = Eigen::Vector3d(0.25, 0.15, 1.0).normalized();
+  for (const RenderItem& item : items) {
+    if (!item.mesh) continue;
+    const Mesh& m = *item.mesh;
+    const Eigen::Isometry3d T = camera_T_world * item.pose;
+    cam_vertices_.resize(m.vertices.size());
+    for (size_t i = 0; i < m.vertices.size(); ++i) cam_vertices_[i] = T * m.vertices[i];
+    for (size_t k = 0; k < m.triangles.size(); ++k) {
+      const auto& tri = m.triangles[k];
+      const Eigen::Vector3d& a = cam_vertices_[tri[0]];
+      const Eigen::Vector3d& b = cam_vertices_[tri[1]];
+      const Eigen::Vector3d& c = cam_vertices_[tri[2]];
+      if (a.z() > cam.far && b.z() > cam.far && c.z() > cam.far) continue;
+      const Eigen::Vector3d n_local = (m.vertices[tri[1]] - m.vertices[tri[0]]).cross(m.vertices[tri[2]] - m.vertices[tri[0]]);
+      const double len = n_local.norm();
+      if (len < 1e-15) continue;
+      const Eigen::Vector3d n = item.pose.linear() * (n_local / len);
+      const float shade = static_cast<float>(0.35 + 0.65 * std::abs(n.dot(light)));
+      const Eigen::Vector3f colour = m.colours[k] * shade;
+      const Eigen::Vector3d* v[3] = {&a, &b, &c};
+      int inside = 0;
+      for (auto* p : v) inside += p->z() >= cam.near;
+      if (inside == 3) {
+        rasterTriangle(a, b, c, cam, colour, item.id, target);
+        continue;
+      }
+      if (inside == 0) continue;
+      // clip against the near plane (Sutherland-Hodgman), then fan
+      Eigen::Vector3d poly[4];
+      int n_out = 0;
+      for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector3d& p = *v[i];
+        const Eigen::Vector3d& q = *v[(i + 1) % 3];
+        const bool pin = p.z() >= cam.near, qin = q.z() >= cam.near;
+        if (pin) poly[n_out++] = p;
+        if (pin != qin) {
+          const double s = (cam.near - p.z()) / (q.z() - p.z());
+          poly[n_out++] = p + s * (q - p);
+        }
+      }
+      for (int i = 1; i + 1 < n_out; ++i) rasterTriangle(poly[0], poly[i], poly[i + 1], cam, colour, item.id, target);
+    }
+  }
+}
+
+}  // namespace rascal_sim

@@ -1,0 +1,147 @@
+#include "rascal_sim/ScenarioGenerator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "rascal_sim/Mesh.hpp"
+
+namespace rascal_sim {
+
+namespace {
+constexpr double kPi = 3.141592653589793;
+
+double uniform(std::mt19937& rng, double a, double b) {
+  return std::uniform_real_distribution<double>(a, b)(rng);
+}
+
+/// Extents along x and y of a length x width box turned by yaw.
+Eigen::Vector2d turnedExtents(double length, double width, double yaw) {
+  const double c = std::abs(std::cos(yaw)), s = std::abs(std::sin(yaw));
+  return {length * c + width * s, length * s + width * c};
+}
+
+// Ware colours seen on sherds (facts sherds_and_colour.md §2d), filtered by the table.
+const char* const kWareChips[] = {
+    "2.5YR 5/6", "2.5YR 6/6", "2.5YR 6/8", "5YR 5/4", "5YR 6/6", "5YR 7/4", "5YR 7/6",
+    "7.5YR 6/4", "7.5YR 5/4", "7.5YR 7/4", "10YR 7/3", "10YR 8/2", "10YR 6/3", "2.5Y 7/3",
+    "2.5Y 8/3", "10YR 5/1", "10YR 6/1", "10YR 4/2", "5Y 5/1", "N5", "10YR 3/1"};
+}  // namespace
+
+ScenarioGenerator::ScenarioGenerator(const MunsellTable& munsell) : munsell_(munsell) {}
+
+std::vector<Eigen::Vector2d> ScenarioGenerator::irregularOutline(double length, double width,
+                                                                 std::mt19937& rng) {
+  const int n = 9 + static_cast<int>(rng() % 5);
+  std::vector<double> radius(n);
+  for (auto& r : radius) r = uniform(rng, 0.78, 1.08);
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * kPi * (i + uniform(rng, -0.3, 0.3)) / n;
+    // light smoothing keeps the broken edges straight-ish but not spiky
+    const double r = 0.5 * radius[i] + 0.25 * radius[(i + 1) % n] + 0.25 * radius[(i + n - 1) % n];
+    pts.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  Eigen::Vector2d lo = pts[0], hi = pts[0];
+  for (const auto& p : pts) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector2d centre = (lo + hi) / 2, ext = hi - lo;
+  for (auto& p : pts) {
+    p = Eigen::Vector2d((p.x() - centre.x()) / ext.x() * length, (p.y() - centre.y()) / ext.y() * width);
+  }
+  return pts;
+}
+
+std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) const {
+  std::mt19937 rng(o.seed);
+  std::vector<SherdSpec> out;
+  if (o.count <= 0) return out;
+  // grid of cells that gives every sherd the largest room
+  int best_rows = 1;
+  double best = -1;
+  for (int rows = 1; rows <= o.count; ++rows) {
+    const int cols = (o.count + rows - 1) / rows;
+    const double m = std::min(o.area.size.x() / cols, o.area.size.y() / rows);
+    if (m > best) {
+      best = m;
+      best_rows = rows;
+    }
+  }
+  const int rows = best_rows, cols = (o.count + rows - 1) / rows;
+  const Eigen::Vector2d cell(o.area.size.x() / cols, o.area.size.y() / rows);
+  const bool long_along_y = cell.y() > cell.x();
+  const double cell_long = std::max(cell.x(), cell.y()), cell_short = std::min(cell.x(), cell.y());
+
+  std::vector<std::string> chips;
+  for (const char* c : kWareChips) {
+    if (munsell_.has(c)) chips.emplace_back(c);
+  }
+  if (chips.empty()) chips.push_back(munsell_.notations().front());
+
+  std::vector<Eigen::Vector2d> lo(o.count), hi(o.count);
+  for (int i = 0; i < o.count; ++i) {
+    SherdSpec s;
+    char name[32];
+    std::snprintf(name, sizeof name, "sherd_%02d", i);
+    s.name = name;
+    const double max_len = std::max(0.02, cell_long - o.min_spacing);
+    const double max_wid = std::max(0.02, cell_short - o.min_spacing);
+    double length = uniform(rng, std::min(o.length_min, max_len), std::min(o.length_max, max_len));
+    double width = uniform(rng, std::min(o.width_min, max_wid), std::min(o.width_max, max_wid));
+    width = std::min(width, length);
+    s.thickness = uniform(rng, o.thickness_min, o.thickness_max);
+    s.curvature = uniform(rng, 0.0, 15.0);
+    s.curvature_long = uniform(rng, 0.0, 4.0);
+    s.convex_up = (rng() % 4) != 0;
+    s.density = uniform(rng, o.density_min, o.density_max);
+    s.munsell = chips[rng() % chips.size()];
+    s.colour = munsell_.srgb(s.munsell);
+    if (uniform(rng, 0.0, 1.0) < o.painted_fraction) {
+      s.pattern = (rng() % 2) ? "stripes" : "band";
+      static const Eigen::Vector3d paints[] = {{0.12, 0.09, 0.07}, {0.55, 0.20, 0.12}, {0.88, 0.83, 0.70}};
+      s.pattern_colour = paints[rng() % 3];
+    }
+    if (i < o.mesh_count && !o.mesh_file.empty()) {
+      s.mesh_file = o.mesh_file;
+      const Mesh m = Mesh::loadStl(o.mesh_file, s.colour);
+      const Eigen::Vector3d ext = m.maxCorner() - m.minCorner();
+      length = std::max(ext.x(), ext.y());
+      width = std::min(ext.x(), ext.y());
+    } else {
+      s.outline = irregularOutline(length, width, rng);
+    }
+    // major axis along the cell's long side, turned a little where the cell leaves room
+    double yaw = long_along_y ? kPi / 2 : 0.0;
+    double jitter = uniform(rng, -0.35, 0.35);
+    for (int k = 0; k < 8; ++k, jitter *= 0.5) {
+      const Eigen::Vector2d e = turnedExtents(length, width, yaw + jitter);
+      if (e.x() <= cell.x() - o.min_spacing && e.y() <= cell.y() - o.min_spacing) break;
+    }
+    yaw += jitter + ((rng() % 2) ? kPi : 0.0);
+    const Eigen::Vector2d ext = turnedExtents(length, width, yaw);
+    const int r = i / cols, c = i % cols;
+    Eigen::Vector2d centre(o.area.position.x() - o.area.size.x() / 2 + (c + 0.5) * cell.x(),
+                           o.area.position.y() - o.area.size.y() / 2 + (r + 0.5) * cell.y());
+    const Eigen::Vector2d slack = (cell - ext - Eigen::Vector2d::Constant(o.min_spacing)).cwiseMax(0.0);
+    centre.x() += uniform(rng, -slack.x() / 2, slack.x() / 2 + 1e-12);
+    centre.y() += uniform(rng, -slack.y() / 2, slack.y() / 2 + 1e-12);
+    s.pose = Eigen::Vector3d(centre.x(), centre.y(), std::remainder(yaw, 2 * kPi));
+    lo[i] = centre - ext / 2;
+    hi[i] = centre + ext / 2;
+    out.push_back(s);
+  }
+  // touching pairs: neighbours in a row pushed together along x until their boxes meet
+  int pairs = 0;
+  for (int i = 0; i + 1 < o.count && pairs < o.touching_pairs; i += 2) {
+    if (i / cols != (i + 1) / cols) continue;
+    const double gap = lo[i + 1].x() - hi[i].x();
+    out[i].pose.x() += gap / 2;
+    out[i + 1].pose.x() -= gap / 2;
+    ++pairs;
+  }
+  return out;
+}
+
+}  // namespace rascal_sim

@@ -1,0 +1,134 @@
+#include "rascal_sim/SensorEffects.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "rascal_sim/Mesh.hpp"
+
+namespace rascal_sim {
+
+namespace {
+constexpr size_t kGaussTable = 1 << 20;
+constexpr double kDepthCx = 319.0;  // [px] D435 depth at 640 x 480 (facts §4.3)
+constexpr double kShadowPeriod = 60.0;  // [s] the shadow's path repeats
+
+uint8_t encodeSrgb(float linear) {
+  static const std::vector<uint8_t> lut = [] {
+    std::vector<uint8_t> l(4097);
+    for (int i = 0; i <= 4096; ++i) {
+      const double c = i / 4096.0;
+      const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+      l[i] = static_cast<uint8_t>(std::lround(std::min(1.0, s) * 255));
+    }
+    return l;
+  }();
+  const int i = static_cast<int>(std::min(1.0f, std::max(0.0f, linear)) * 4096.0f + 0.5f);
+  return lut[i];
+}
+}  // namespace
+
+SensorEffects::SensorEffects(unsigned seed) : rng_(seed), gauss_(kGaussTable) {
+  std::normal_distribution<float> n(0.0f, 1.0f);
+  for (auto& g : gauss_) g = n(rng_);
+}
+
+float SensorEffects::gauss() {
+  cursor_ = (cursor_ + 1) & (kGaussTable - 1);
+  return gauss_[cursor_];
+}
+
+Eigen::Vector3d SensorEffects::temperatureGains(double kelvin) {
+  // Approximate sRGB colour of black-body light (D65 white), every 500 K from 2500 to 10000 K.
+  static const double table[][3] = {
+      {1.00, 0.62, 0.30}, {1.00, 0.69, 0.42}, {1.00, 0.75, 0.53}, {1.00, 0.80, 0.63},
+      {1.00, 0.85, 0.72}, {1.00, 0.89, 0.80}, {1.00, 0.93, 0.87}, {1.00, 0.96, 0.94},
+      {1.00, 0.99, 1.00}, {0.95, 0.96, 1.00}, {0.92, 0.94, 1.00}, {0.89, 0.92, 1.00},
+      {0.86, 0.905, 1.00}, {0.84, 0.89, 1.00}, {0.82, 0.875, 1.00}, {0.80, 0.86, 1.00}};
+  const double k = std::min(10000.0, std::max(2500.0, kelvin));
+  const double f = (k - 2500.0) / 500.0;
+  const int i = std::min(14, static_cast<int>(f));
+  const double s = f - i;
+  Eigen::Vector3d c, ref(table[8][0], table[8][1], table[8][2]);
+  for (int j = 0; j < 3; ++j) c[j] = table[i][j] * (1 - s) + table[i + 1][j] * s;
+  const Eigen::Vector3f lin = Mesh::srgbToLinear(c), lin_ref = Mesh::srgbToLinear(ref);
+  Eigen::Vector3d g(lin.x() / lin_ref.x(), lin.y() / lin_ref.y(), lin.z() / lin_ref.z());
+  return g / (0.2126 * g.x() + 0.7152 * g.y() + 0.0722 * g.z());
+}
+
+cv::Mat SensorEffects::colourImage(const cv::Mat& radiance, const cv::Mat& depth, const CameraModel& cam,
+                                   const Eigen::Isometry3d& world_T_camera, const Lighting& lighting,
+                                   double t, double blur_px) {
+  const Eigen::Vector3d gain = temperatureGains(lighting.colour_temperature) * lighting.brightness;
+  const float g0 = static_cast<float>(gain.x()), g1 = static_cast<float>(gain.y()), g2 = static_cast<float>(gain.z());
+  const bool shadow = lighting.shadow_strength > 0.0;
+  const Eigen::Vector2d centre = lighting.shadow_start + lighting.shadow_velocity * std::fmod(t, kShadowPeriod);
+  const double r_out = lighting.shadow_radius, r_in = 0.6 * lighting.shadow_radius;
+  const Eigen::Matrix3d R = world_T_camera.linear();
+  const Eigen::Vector3d p0 = world_T_camera.translation();
+  cv::Mat img(cam.height, cam.width, CV_8UC3);
+  for (int y = 0; y < cam.height; ++y) {
+    const cv::Vec3f* rrow = radiance.ptr<cv::Vec3f>(y);
+    const float* drow = depth.ptr<float>(y);
+    cv::Vec3b* out = img.ptr<cv::Vec3b>(y);
+    const double ny = (y - cam.cy) / cam.fy;
+    for (int x = 0; x < cam.width; ++x) {
+      float f = 1.0f;
+      if (shadow && drow[x] > 0) {
+        const double z = drow[x];
+        const Eigen::Vector3d pw = R * Eigen::Vector3d((x - cam.cx) / cam.fx * z, ny * z, z) + p0;
+        const double d = (pw.head<2>() - centre).norm();
+        if (d < r_out) {
+          const double s = d <= r_in ? 1.0 : (r_out - d) / (r_out - r_in);
+          f = static_cast<float>(1.0 - lighting.shadow_strength * s * s * (3 - 2 * s));
+        }
+      }
+      const cv::Vec3f& c = rrow[x];
+      out[x] = cv::Vec3b(encodeSrgb(c[0] * g0 * f), encodeSrgb(c[1] * g1 * f), encodeSrgb(c[2] * g2 * f));
+    }
+  }
+  if (blur_px >= 1.5) {
+    const int k = std::min(31, static_cast<int>(std::lround(blur_px)) | 1);
+    cv::blur(img, img, cv::Size(k, k));
+  }
+  const float sigma = static_cast<float>(lighting.colour_noise);
+  if (sigma > 0) {
+    cursor_ = rng_() & (kGaussTable - 1);
+    uint8_t* p = img.ptr<uint8_t>(0);
+    const size_t n = img.total() * 3;
+    for (size_t i = 0; i < n; ++i) {
+      const float v = p[i] + sigma * gauss();
+      p[i] = static_cast<uint8_t>(std::min(255.0f, std::max(0.0f, v + 0.5f)));
+    }
+  }
+  return img;
+}
+
+cv::Mat SensorEffects::depthImage(const cv::Mat& depth, const CameraModel& cam, bool left_band) {
+  cv::Mat out(cam.height, cam.width, CV_16UC1);
+  cursor_ = rng_() & (kGaussTable - 1);
+  for (int y = 0; y < cam.height; ++y) {
+    const float* d = depth.ptr<float>(y);
+    uint16_t* o = out.ptr<uint16_t>(y);
+    for (int x = 0; x < cam.width; ++x) {
+      const double z = d[x];
+      if (z < kMinDepth) {
+        o[x] = 0;
+        continue;
+      }
+      if (left_band) {
+        // left invalid band: seen by the left imager only, f*B/Z depth pixels wide
+        const double edge = (kDepthFocal * kBaseline / z - kDepthCx) / kDepthFocal;
+        if ((x - cam.cx) / cam.fx < edge) {
+          o[x] = 0;
+          continue;
+        }
+      }
+      const double zn = z + depthSigma(z) * gauss();
+      o[x] = static_cast<uint16_t>(std::min(65535.0, std::max(0.0, std::round(zn * 1000.0))));
+    }
+  }
+  return out;
+}
+
+}  // namespace rascal_sim

@@ -1,0 +1,190 @@
+#include "rascal_sim/Simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rascal_sim {
+
+namespace {
+constexpr double kExposure = 0.01;  // [s] wrist colour exposure used for the blur length
+}
+
+Simulator::Simulator(const WorldLayout& layout, const SimulatorOptions& options)
+    : layout_(layout),
+      options_(options),
+      world_(layout),
+      servos_(options.initial_joints),
+      gripper_(options.initial_finger),
+      scale_(7),
+      archival_(layout, options.archival_width, options.archival_height),
+      effects_(11),
+      rng_(1) {
+  world_.placeArm(servos_.positions(), gripper_.position());
+}
+
+void Simulator::load(const Scenario& scenario) {
+  world_.spawn(scenario.sherds);
+  scenario_ = scenario;
+  rng_.seed(scenario.seed);
+  slip_armed_ = false;
+}
+
+void Simulator::reset() {
+  world_.release();
+  world_.spawn(scenario_.sherds);
+  servos_.reset(options_.initial_joints);
+  gripper_.reset(options_.initial_finger);
+  world_.placeArm(servos_.positions(), gripper_.position());
+  rng_.seed(scenario_.seed);
+  slip_armed_ = false;
+  drop_next_grasp_ = false;
+}
+
+void Simulator::commandArm(double start_time, const std::vector<TrajectoryPoint>& points,
+                           const std::array<bool, kArmJoints>& mask) {
+  servos_.setTrajectory(time(), start_time, points, mask);
+}
+
+void Simulator::commandGripper(double finger_position) { gripper_.setTarget(finger_position); }
+
+void Simulator::step() {
+  const double dt = options_.physics_dt;
+  const double now = time();
+  servos_.step(now, dt);
+  const FingerContacts& fc = world_.fingerContacts();
+  const bool squeezed = fc.left >= 0 && fc.left == fc.right;
+  const bool blocked = world_.held() >= 0 || squeezed || fc.left_depth > 0.002 || fc.right_depth > 0.002;
+  gripper_.step(dt, blocked);
+  world_.setArmTarget(servos_.positions(), gripper_.position());
+  world_.step(dt);
+  updateGrasp();
+  if (scale_.update(time(), dt, world_.scaleLoad())) scale_fresh_ = true;
+  if (archival_.update(time(), world_.armPose())) archival_.deliver(time(), renderArchival());
+}
+
+void Simulator::updateGrasp() {
+  const int held = world_.held();
+  if (held >= 0) {
+    if (gripper_.opening()) {
+      world_.release();
+      slip_armed_ = false;
+      return;
+    }
+    if (slip_armed_) {
+      const double z = world_.sherd(held).pose.translation().z();
+      if (z > grasp_z_ + 0.01) {
+        if (slip_lifted_since_ < 0) slip_lifted_since_ = time();
+        if (time() - slip_lifted_since_ >= slip_delay_) {
+          world_.release();
+          world_.ignoreGripperContacts(held, time() + 0.6);
+          slip_armed_ = false;
+        }
+      }
+    }
+    return;
+  }
+  const FingerContacts& fc = world_.fingerContacts();
+  if (!(gripper_.target() < gripper_.position() - 1e-6) || fc.left < 0 || fc.left != fc.right) return;
+  const int i = fc.left;
+  world_.hold(i);
+  const SherdState s = world_.sherd(i);
+  grasp_z_ = s.pose.translation().z();
+  // Slip model (a simulator choice, not a measured figure): off-centre grasps, fingers closing
+  // along the long axis and payloads above the 0.25 kg working payload slip more often.
+  const auto& arm = world_.armPose();
+  const Eigen::Vector3d c = s.pose.inverse() * arm[kEeGripperLink].translation();
+  const double off = std::min(1.0, std::hypot(c.x(), c.y()) / std::max(1e-3, 0.5 * s.length));
+  const Eigen::Vector3d a = s.pose.linear().transpose() * arm[kFingersLink].linear().col(1);
+  const double along = std::abs(a.x()) / std::max(1e-9, std::hypot(a.x(), a.y()));
+  const double elongation = 1.0 - s.width / std::max(1e-9, s.length);
+  double p = 0.02 + 0.5 * off * off + 0.6 * along * along * std::min(1.0, 0.3 + 2.0 * elongation);
+  if (s.mass > kMaxPayload) p += 0.9;
+  p = std::min(0.98, p);
+  const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng_);
+  slip_armed_ = drop_next_grasp_ || u < p;
+  drop_next_grasp_ = false;
+  slip_delay_ = std::uniform_real_distribution<double>(0.05, 0.6)(rng_);
+  slip_lifted_since_ = -1.0;
+}
+
+bool Simulator::takeScaleReading(ScaleReading& reading) {
+  if (!scale_fresh_) return false;
+  scale_fresh_ = false;
+  reading = scale_.latest();
+  return true;
+}
+
+bool Simulator::wristFrameDue() const {
+  return options_.wrist_camera && time() >= next_wrist_frame_ - 1e-9;
+}
+
+Eigen::Isometry3d Simulator::wristCameraPose() const {
+  return world_.armPose()[kCameraColorOpticalFrame];
+}
+
+WristFrame Simulator::renderWristFrame() {
+  WristFrame f;
+  f.stamp = time();
+  f.world_T_camera = wristCameraPose();
+  world_.renderItems(items_, true);
+  const CameraModel& cam = options_.wrist_model;
+  renderer_.render(items_, cam, f.world_T_camera, scratch_);
+  const double speed = std::max(servos_.maxSpeed(), 0.0);
+  double blur = 0.0;
+  if (speed > kBlurSpeed) {
+    f.blurred = true;
+    blur = std::max(3.0, speed * cam.fx * kExposure);
+  }
+  f.rgb = effects_.colourImage(scratch_.radiance, scratch_.depth, cam, f.world_T_camera, scenario_.lighting,
+                               f.stamp, blur);
+  f.depth_mm = effects_.depthImage(scratch_.depth, cam);
+  const double period = 1.0 / options_.wrist_rate;
+  while (next_wrist_frame_ <= time() + 1e-9) next_wrist_frame_ += period;
+  return f;
+}
+
+cv::Mat Simulator::renderArchival() {
+  world_.renderItems(items_, true);
+  RenderOutput out;
+  renderer_.render(items_, archival_.model(), archival_.pose(), out);
+  return effects_.colourImage(out.radiance, out.depth, archival_.model(), archival_.pose(), scenario_.lighting,
+                              time(), 0.0);
+}
+
+bool Simulator::triggerCapture(std::string& why) {
+  return archival_.trigger(time(), time() < camera_fault_until_, camera_fault_until_, why);
+}
+
+bool Simulator::injectFault(int fault, double duration, std::string& message) {
+  switch (fault) {
+    case static_cast<int>(Fault::kDropNextGrasp):
+      drop_next_grasp_ = true;
+      message = "the next grasped sherd slips out after lift";
+      return true;
+    case static_cast<int>(Fault::kScaleGlitch):
+    case static_cast<int>(Fault::kCameraTimeout):
+      if (!(duration > 0.0)) {
+        message = "duration must be > 0 s for this fault";
+        return false;
+      }
+      if (fault == static_cast<int>(Fault::kScaleGlitch)) {
+        scale_.glitch(time() + duration);
+        message = "scale readings are garbage and unstable for " + std::to_string(duration) + " s";
+      } else {
+        camera_fault_until_ = time() + duration;
+        message = "archival camera does not answer for " + std::to_string(duration) + " s";
+      }
+      return true;
+    default:
+      message = "unknown fault " + std::to_string(fault) + " (0 drop, 1 scale glitch, 2 camera timeout)";
+      return false;
+  }
+}
+
+std::vector<SherdState> Simulator::groundTruth() const {
+  std::vector<SherdState> out;
+  for (size_t i = 0; i < world_.sherdCount(); ++i) out.push_back(world_.sherd(i));
+  return out;
+}
+
+}  // namespace rascal_sim

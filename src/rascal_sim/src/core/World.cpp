@@ -1,0 +1,439 @@
+#include "rascal_sim/World.hpp"
+
+#include <ode/ode.h>
+
+#include <cmath>
+#include <deque>
+#include <mutex>
+#include <stdexcept>
+
+#include "rascal_sim/MunsellTable.hpp"
+#include "rascal_sim/SherdMeshBuilder.hpp"
+
+namespace rascal_sim {
+
+namespace {
+constexpr double kGravity = 9.81;
+constexpr double kPlatformMass = 0.30;       // [kg] the weighing pan (tared away)
+constexpr double kPlatformThickness = 0.010;  // [m]
+
+struct GeomTag {
+  enum Kind { kTable, kStatic, kPlatform, kSherd, kArm, kLeftFinger, kRightFinger } kind;
+  int index;
+};
+
+void odeInitOnce() {
+  static std::once_flag flag;
+  std::call_once(flag, [] { dInitODE2(0); });
+}
+
+void toOde(const Eigen::Matrix3d& r, dMatrix3 m) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m[i * 4 + j] = r(i, j);
+    m[i * 4 + 3] = 0;
+  }
+}
+
+Eigen::Isometry3d bodyPose(dBodyID b) {
+  const dReal* p = dBodyGetPosition(b);
+  const dReal* r = dBodyGetRotation(b);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) t.linear()(i, j) = r[i * 4 + j];
+  }
+  t.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
+  return t;
+}
+}  // namespace
+
+struct World::Impl {
+  struct Sherd {
+    SherdSpec spec;
+    SherdGeometry geo;
+    dBodyID body = nullptr;
+    dGeomID geom = nullptr;
+    GeomTag tag{GeomTag::kSherd, 0};
+    double ignore_until = -1.0;
+  };
+
+  dWorldID world = nullptr;
+  dSpaceID space = nullptr;
+  dJointGroupID contact_group = nullptr;
+  std::deque<GeomTag> tags;  // stable addresses for dGeomSetData
+  dBodyID platform = nullptr;
+  dJointID platform_joint = nullptr;
+  dJointFeedback platform_feedback{};
+  double load = 0.0;
+  std::vector<std::unique_ptr<Sherd>> sherds;
+  std::vector<dBodyID> link_bodies;  // one per arm link that carries boxes (index = ArmLink)
+  std::array<Eigen::Isometry3d, kArmLinkCount> arm_pose, arm_target;
+  std::vector<Mesh> link_meshes;     // one per LinkBox
+  dJointID hold_joint = nullptr;
+  int held = -1;
+  FingerContacts contacts_now, contacts_last;
+  Mesh fixtures;
+  double time = 0.0;
+
+  GeomTag* tag(GeomTag::Kind k, int i) {
+    tags.push_back({k, i});
+    return &tags.back();
+  }
+
+  void staticBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size) {
+    dGeomID g = dCreateBox(space, size.x(), size.y(), size.z());
+    dGeomSetPosition(g, centre.x(), centre.y(), centre.z());
+    dGeomSetData(g, tag(GeomTag::kStatic, 0));
+  }
+
+  static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
+    static_cast<Impl*>(data)->collide(o1, o2);
+  }
+
+  void collide(dGeomID o1, dGeomID o2) {
+    dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
+    const bool dyn1 = b1 && !dBodyIsKinematic(b1), dyn2 = b2 && !dBodyIsKinematic(b2);
+    if (!dyn1 && !dyn2) return;
+    const GeomTag* t1 = static_cast<const GeomTag*>(dGeomGetData(o1));
+    const GeomTag* t2 = static_cast<const GeomTag*>(dGeomGetData(o2));
+    if (!t1 || !t2) return;
+    if (t2->kind == GeomTag::kSherd && t1->kind != GeomTag::kSherd) {
+      std::swap(o1, o2);
+      std::swap(b1, b2);
+      std::swap(t1, t2);
+    }
+    if (t1->kind == GeomTag::kPlatform &&
+        (t2->kind == GeomTag::kStatic || t2->kind == GeomTag::kTable)) return;
+    if (t2->kind == GeomTag::kPlatform &&
+        (t1->kind == GeomTag::kStatic || t1->kind == GeomTag::kTable)) return;
+    const bool arm2 = t2->kind == GeomTag::kArm || t2->kind == GeomTag::kLeftFinger ||
+                      t2->kind == GeomTag::kRightFinger;
+    if (t1->kind == GeomTag::kSherd && arm2) {
+      const Sherd& s = *sherds[t1->index];
+      if (t1->index == held || time < s.ignore_until) return;
+    }
+    dContact c[4];
+    const int n = dCollide(o1, o2, 4, &c[0].geom, sizeof(dContact));
+    if (n == 0) return;
+    double mu = 0.6;
+    if (t1->kind == GeomTag::kSherd) {
+      if (t2->kind == GeomTag::kLeftFinger || t2->kind == GeomTag::kRightFinger) mu = 1.2;
+      else if (t2->kind == GeomTag::kSherd) mu = 0.45;
+      else mu = 0.55;
+    }
+    double depth = 0.0;
+    for (int i = 0; i < n; ++i) {
+      c[i].surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
+      c[i].surface.mu = mu;
+      c[i].surface.soft_erp = 0.3;
+      c[i].surface.soft_cfm = 1e-6;
+      dJointID j = dJointCreateContact(world, contact_group, &c[i]);
+      dJointAttach(j, b1, b2);
+      depth = std::max(depth, static_cast<double>(c[i].geom.depth));
+    }
+    if (t1->kind == GeomTag::kSherd) {
+      if (t2->kind == GeomTag::kLeftFinger && depth >= contacts_now.left_depth) {
+        contacts_now.left = t1->index;
+        contacts_now.left_depth = depth;
+      } else if (t2->kind == GeomTag::kRightFinger && depth >= contacts_now.right_depth) {
+        contacts_now.right = t1->index;
+        contacts_now.right_depth = depth;
+      }
+    }
+  }
+
+  void buildFixtures(const WorldLayout& l) {
+    Mesh& m = fixtures;
+    m.addRect(0.25, 0.0, 1.3, 1.5, 0.0, l.table_colour);
+    const double mz = 0.0004;
+    m.addRect(l.pickup.position.x(), l.pickup.position.y(), l.pickup.size.x(), l.pickup.size.y(), mz, l.mat_colour);
+    m.addRect(l.discard.position.x(), l.discard.position.y(), l.discard.size.x(), l.discard.size.y(), mz, l.mat_colour);
+    // scale: housing and the two-tone platform (dark rim, light pan)
+    const Eigen::Vector3d sc(l.scale.position.x(), l.scale.position.y(), 0.0);
+    const double top = l.scale_surface_z;
+    const double housing_h = top - kPlatformThickness;
+    m.addBox({sc.x(), sc.y(), housing_h / 2}, {l.scale.size.x() + 0.03, l.scale.size.y() + 0.03, housing_h},
+             l.scale_colours[1] * 0.8);
+    m.addBox({sc.x(), sc.y(), top - kPlatformThickness / 2}, {l.scale.size.x(), l.scale.size.y(), kPlatformThickness},
+             l.scale_colours[1]);
+    m.addRect(sc.x(), sc.y(), l.scale.size.x() - 0.02, l.scale.size.y() - 0.02, top + 0.0003, l.scale_colours[0]);
+    // colour chart: black card with 4 x 6 patches, row 1 at +y
+    const auto& cc = l.colour_chart;
+    m.addRect(cc.position.x(), cc.position.y(), cc.size.x(), cc.size.y(), 0.0008, {0.05, 0.05, 0.05});
+    const auto patches = MunsellTable::readColourChecker(l.data_dir + "/colorchecker24_xrite_after2014_D50.csv");
+    const double pw = cc.size.x() / 6, ph = cc.size.y() / 4;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 6; ++c) {
+        const double x = cc.position.x() - cc.size.x() / 2 + (c + 0.5) * pw;
+        const double y = cc.position.y() + cc.size.y() / 2 - (r + 0.5) * ph;
+        m.addRect(x, y, pw * 0.8, ph * 0.8, 0.0012, patches[r * 6 + c]);
+      }
+    }
+    // scale bar: 10 cm, two rows; -x half a 1 cm chequer, +x half black over white
+    const auto& sb = l.scale_bar;
+    const double row = sb.size.y() / 2, cell = sb.size.x() / 10;
+    for (int i = 0; i < 10; ++i) {
+      for (int r = 0; r < 2; ++r) {
+        const double x = sb.position.x() - sb.size.x() / 2 + (i + 0.5) * cell;
+        const double y = sb.position.y() + (r == 0 ? row / 2 : -row / 2);
+        const bool black = i < 5 ? ((i + r) % 2 == 0) : (r == 0);
+        m.addRect(x, y, cell, row, 0.0008, black ? Eigen::Vector3d(0.04, 0.04, 0.04) : Eigen::Vector3d(0.95, 0.95, 0.95));
+      }
+    }
+    // camera stand: post, boom and camera body above the lens
+    const double lens = l.camera_height;
+    m.addBox({l.stand.position.x(), l.stand.position.y(), l.stand_height / 2},
+             {l.stand.size.x(), l.stand.size.y(), l.stand_height}, {0.3, 0.3, 0.32});
+    const double boom_x0 = l.camera.position.x(), boom_x1 = l.stand.position.x();
+    m.addBox({(boom_x0 + boom_x1) / 2, l.camera.position.y(), lens + 0.06}, {boom_x1 - boom_x0, 0.03, 0.02},
+             {0.3, 0.3, 0.32});
+    m.addBox({l.camera.position.x(), l.camera.position.y(), lens + 0.035}, {0.11, 0.07, 0.07}, {0.08, 0.08, 0.08});
+    // discard box walls
+    const auto& d = l.discard;
+    const double w = 0.005, h = l.discard_wall_height;
+    const Eigen::Vector3d grey(0.45, 0.40, 0.33);
+    m.addBox({d.position.x(), d.position.y() + d.size.y() / 2, h / 2}, {d.size.x() + w, w, h}, grey);
+    m.addBox({d.position.x(), d.position.y() - d.size.y() / 2, h / 2}, {d.size.x() + w, w, h}, grey);
+    m.addBox({d.position.x() + d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h}, grey);
+    m.addBox({d.position.x() - d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h}, grey);
+  }
+
+  void buildPhysics(const WorldLayout& l) {
+    dGeomID plane = dCreatePlane(space, 0, 0, 1, 0);
+    dGeomSetData(plane, tag(GeomTag::kTable, 0));
+    const double top = l.scale_surface_z;
+    const double housing_h = top - kPlatformThickness;
+    staticBox({l.scale.position.x(), l.scale.position.y(), housing_h / 2},
+              {l.scale.size.x() + 0.03, l.scale.size.y() + 0.03, housing_h});
+    platform = dBodyCreate(world);
+    dMass m;
+    dMassSetBoxTotal(&m, kPlatformMass, l.scale.size.x(), l.scale.size.y(), kPlatformThickness);
+    dBodySetMass(platform, &m);
+    dBodySetPosition(platform, l.scale.position.x(), l.scale.position.y(), top - kPlatformThickness / 2);
+    dGeomID pg = dCreateBox(space, l.scale.size.x(), l.scale.size.y(), kPlatformThickness);
+    dGeomSetBody(pg, platform);
+    dGeomSetData(pg, tag(GeomTag::kPlatform, 0));
+    platform_joint = dJointCreateFixed(world, nullptr);
+    dJointAttach(platform_joint, platform, nullptr);
+    dJointSetFixed(platform_joint);
+    dJointSetFeedback(platform_joint, &platform_feedback);
+    staticBox({l.stand.position.x(), l.stand.position.y(), l.stand_height / 2},
+              {l.stand.size.x(), l.stand.size.y(), l.stand_height});
+    const auto& d = l.discard;
+    const double w = 0.005, h = l.discard_wall_height;
+    staticBox({d.position.x(), d.position.y() + d.size.y() / 2, h / 2}, {d.size.x() + w, w, h});
+    staticBox({d.position.x(), d.position.y() - d.size.y() / 2, h / 2}, {d.size.x() + w, w, h});
+    staticBox({d.position.x() + d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h});
+    staticBox({d.position.x() - d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h});
+    // arm: one kinematic body per link that carries boxes
+    link_bodies.assign(kArmLinkCount, nullptr);
+    for (const LinkBox& b : ArmKinematics::linkBoxes()) {
+      if (!link_bodies[b.link]) {
+        link_bodies[b.link] = dBodyCreate(world);
+        dBodySetKinematic(link_bodies[b.link]);
+      }
+      dGeomID g = dCreateBox(space, b.size.x(), b.size.y(), b.size.z());
+      dGeomSetBody(g, link_bodies[b.link]);
+      dGeomSetOffsetPosition(g, b.offset.translation().x(), b.offset.translation().y(), b.offset.translation().z());
+      dMatrix3 r;
+      toOde(b.offset.linear(), r);
+      dGeomSetOffsetRotation(g, r);
+      GeomTag::Kind k = b.link == kLeftFingerLink ? GeomTag::kLeftFinger
+                        : b.link == kRightFingerLink ? GeomTag::kRightFinger : GeomTag::kArm;
+      dGeomSetData(g, tag(k, b.link));
+      Mesh lm;
+      lm.addBox(Eigen::Vector3d::Zero(), b.size, b.srgb);
+      link_meshes.push_back(lm);
+    }
+  }
+
+  void setLinkBodies(bool with_velocity, double dt) {
+    for (int i = 0; i < kArmLinkCount; ++i) {
+      dBodyID b = link_bodies[i];
+      if (!b) continue;
+      const Eigen::Isometry3d& now = arm_pose[i];
+      const Eigen::Isometry3d& next = arm_target[i];
+      if (with_velocity) {
+        const Eigen::Vector3d v = (next.translation() - now.translation()) / dt;
+        const Eigen::AngleAxisd aa(next.linear() * now.linear().transpose());
+        const Eigen::Vector3d w = aa.axis() * (aa.angle() / dt);
+        dBodySetLinearVel(b, v.x(), v.y(), v.z());
+        dBodySetAngularVel(b, w.x(), w.y(), w.z());
+      } else {
+        dBodySetPosition(b, next.translation().x(), next.translation().y(), next.translation().z());
+        dMatrix3 r;
+        toOde(next.linear(), r);
+        dBodySetRotation(b, r);
+      }
+    }
+  }
+};
+
+World::World(const WorldLayout& layout) : impl_(new Impl), layout_(layout) {
+  odeInitOnce();
+  Impl& w = *impl_;
+  w.world = dWorldCreate();
+  dWorldSetGravity(w.world, 0, 0, -kGravity);
+  dWorldSetERP(w.world, 0.2);
+  dWorldSetCFM(w.world, 1e-7);
+  dWorldSetQuickStepNumIterations(w.world, 40);
+  dWorldSetContactMaxCorrectingVel(w.world, 0.2);
+  dWorldSetContactSurfaceLayer(w.world, 0.0002);
+  dWorldSetAutoDisableFlag(w.world, 0);
+  w.space = dHashSpaceCreate(nullptr);
+  w.contact_group = dJointGroupCreate(0);
+  w.buildFixtures(layout);
+  w.buildPhysics(layout);
+  JointVector q{0.0, -1.80, 1.55, 0.0, 0.8, 0.0};
+  placeArm(q, ArmKinematics::kFingerMax);
+}
+
+World::~World() {
+  Impl& w = *impl_;
+  clearSherds();
+  dJointGroupDestroy(w.contact_group);
+  dSpaceDestroy(w.space);
+  dWorldDestroy(w.world);
+}
+
+void World::clearSherds() {
+  Impl& w = *impl_;
+  release();
+  for (auto& s : w.sherds) {
+    dGeomDestroy(s->geom);
+    dBodyDestroy(s->body);
+  }
+  w.sherds.clear();
+}
+
+void World::spawn(const std::vector<SherdSpec>& sherds) {
+  clearSherds();
+  Impl& w = *impl_;
+  for (size_t i = 0; i < sherds.size(); ++i) {
+    auto s = std::make_unique<Impl::Sherd>();
+    s->spec = sherds[i];
+    s->geo = SherdMeshBuilder::build(s->spec);
+    if (s->geo.mass <= 0.0) throw std::runtime_error("sherd " + s->spec.name + " has no volume");
+    const Eigen::Vector3d& size = s->geo.box_size;
+    s->body = dBodyCreate(w.world);
+    dMass m;
+    dMassSetBoxTotal(&m, s->geo.mass, size.x(), size.y(), size.z());
+    dBodySetMass(s->body, &m);
+    const double x = s->spec.pose.x(), y = s->spec.pose.y();
+    double support = 0.0;
+    if (std::abs(x - layout_.scale.position.x()) < layout_.scale.size.x() / 2 &&
+        std::abs(y - layout_.scale.position.y()) < layout_.scale.size.y() / 2) {
+      support = layout_.scale_surface_z;
+    }
+    dBodySetPosition(s->body, x, y, support + size.z() / 2 + s->spec.drop_height + 1e-4);
+    dMatrix3 r;
+    dRFromAxisAndAngle(r, 0, 0, 1, s->spec.pose.z());
+    dBodySetRotation(s->body, r);
+    dBodySetLinearDamping(s->body, 0.001);
+    dBodySetAngularDamping(s->body, 0.01);
+    s->geom = dCreateBox(w.space, size.x(), size.y(), size.z());
+    dGeomSetBody(s->geom, s->body);
+    s->tag.index = static_cast<int>(i);
+    dGeomSetData(s->geom, &s->tag);
+    w.sherds.push_back(std::move(s));
+  }
+}
+
+void World::placeArm(const JointVector& q, double finger) {
+  Impl& w = *impl_;
+  release();
+  w.arm_pose = ArmKinematics::forward(q, finger);
+  w.arm_target = w.arm_pose;
+  w.setLinkBodies(false, 1.0);
+  for (dBodyID b : w.link_bodies) {
+    if (!b) continue;
+    dBodySetLinearVel(b, 0, 0, 0);
+    dBodySetAngularVel(b, 0, 0, 0);
+  }
+}
+
+void World::setArmTarget(const JointVector& q, double finger) {
+  impl_->arm_target = ArmKinematics::forward(q, finger);
+}
+
+void World::step(double dt) {
+  Impl& w = *impl_;
+  w.time = time_;
+  w.setLinkBodies(true, dt);
+  w.contacts_now = FingerContacts();
+  dSpaceCollide(w.space, &w, &Impl::nearCallback);
+  dWorldQuickStep(w.world, dt);
+  dJointGroupEmpty(w.contact_group);
+  w.setLinkBodies(false, dt);
+  w.arm_pose = w.arm_target;
+  w.contacts_last = w.contacts_now;
+  w.load = w.platform_feedback.f1[2] / kGravity - kPlatformMass;
+  // the pan is fixed to the world: keep numerical drift out of it
+  time_ += dt;
+}
+
+double World::scaleLoad() const { return impl_->load; }
+
+const FingerContacts& World::fingerContacts() const { return impl_->contacts_last; }
+
+void World::hold(int sherd) {
+  Impl& w = *impl_;
+  if (w.held == sherd || sherd < 0 || sherd >= static_cast<int>(w.sherds.size())) return;
+  release();
+  w.hold_joint = dJointCreateFixed(w.world, nullptr);
+  dJointAttach(w.hold_joint, w.sherds[sherd]->body, w.link_bodies[kGripperLink]);
+  dJointSetFixed(w.hold_joint);
+  w.held = sherd;
+}
+
+void World::release() {
+  Impl& w = *impl_;
+  if (w.hold_joint) dJointDestroy(w.hold_joint);
+  w.hold_joint = nullptr;
+  w.held = -1;
+}
+
+int World::held() const { return impl_->held; }
+
+void World::ignoreGripperContacts(int sherd, double until) {
+  if (sherd >= 0 && sherd < static_cast<int>(impl_->sherds.size())) impl_->sherds[sherd]->ignore_until = until;
+}
+
+size_t World::sherdCount() const { return impl_->sherds.size(); }
+
+SherdState World::sherd(size_t i) const {
+  const Impl::Sherd& s = *impl_->sherds.at(i);
+  SherdState st;
+  st.name = s.spec.name;
+  st.pose = bodyPose(s.body);
+  const dReal* v = dBodyGetLinearVel(s.body);
+  const dReal* a = dBodyGetAngularVel(s.body);
+  st.linear_velocity = Eigen::Vector3d(v[0], v[1], v[2]);
+  st.angular_velocity = Eigen::Vector3d(a[0], a[1], a[2]);
+  st.mass = s.geo.mass;
+  st.thickness = s.spec.mesh_file.empty() ? s.spec.thickness : s.geo.box_size.z();
+  st.length = s.geo.length;
+  st.width = s.geo.width;
+  st.box_size = s.geo.box_size;
+  st.outline = s.geo.outline;
+  st.colour = s.spec.colour;
+  st.held = static_cast<int>(i) == impl_->held;
+  return st;
+}
+
+const std::array<Eigen::Isometry3d, kArmLinkCount>& World::armPose() const { return impl_->arm_pose; }
+
+void World::renderItems(std::vector<RenderItem>& items, bool include_arm) const {
+  const Impl& w = *impl_;
+  items.clear();
+  items.push_back({&w.fixtures, Eigen::Isometry3d::Identity(), 1});
+  for (size_t i = 0; i < w.sherds.size(); ++i) {
+    items.push_back({&w.sherds[i]->geo.mesh, bodyPose(w.sherds[i]->body), static_cast<int>(10 + i)});
+  }
+  if (!include_arm) return;
+  const auto& boxes = ArmKinematics::linkBoxes();
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    items.push_back({&w.link_meshes[i], w.arm_pose[boxes[i].link] * boxes[i].offset, 2});
+  }
+}
+
+}  // namespace rascal_sim

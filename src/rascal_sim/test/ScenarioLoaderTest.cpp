@@ -1,0 +1,97 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rascal_sim/MunsellTable.hpp"
+#include "rascal_sim/ScenarioLoader.hpp"
+#include "rascal_sim/SherdMeshBuilder.hpp"
+
+using namespace rascal_sim;
+
+namespace {
+struct Fixture {
+  WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
+  MunsellTable munsell{std::string(RASCAL_SIM_DATA_DIR) + "/munsell_soil_hues_grid_renotation.csv"};
+};
+
+void worldBox(const SherdSpec& s, Eigen::Vector2d& lo, Eigen::Vector2d& hi) {
+  const Eigen::Rotation2Dd r(s.pose.z());
+  lo = Eigen::Vector2d::Constant(1e9);
+  hi = -lo;
+  for (const auto& p : s.outline) {
+    const Eigen::Vector2d w = r * p + s.pose.head<2>();
+    lo = lo.cwiseMin(w);
+    hi = hi.cwiseMax(w);
+  }
+}
+}  // namespace
+
+TEST(ScenarioLoader, GeneratesSeededSpacedSherdsOnThePickupMat) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  const std::string yaml = "name: t\nseed: 4\ngenerate: {count: 10, station: pickup, min_spacing: 0.012}\n";
+  const Scenario a = loader.parse(yaml);
+  const Scenario b = loader.parse(yaml);
+  ASSERT_EQ(a.sherds.size(), 10u);
+  for (size_t i = 0; i < a.sherds.size(); ++i) {
+    EXPECT_EQ(a.sherds[i].pose, b.sherds[i].pose);
+    Eigen::Vector2d lo, hi;
+    worldBox(a.sherds[i], lo, hi);
+    const Eigen::Vector2d mat_lo = f.layout.pickup.position - f.layout.pickup.size / 2;
+    const Eigen::Vector2d mat_hi = f.layout.pickup.position + f.layout.pickup.size / 2;
+    EXPECT_GE(lo.x(), mat_lo.x() - 1e-9);
+    EXPECT_GE(lo.y(), mat_lo.y() - 1e-9);
+    EXPECT_LE(hi.x(), mat_hi.x() + 1e-9);
+    EXPECT_LE(hi.y(), mat_hi.y() + 1e-9);
+    for (size_t j = 0; j < i; ++j) {
+      Eigen::Vector2d lo2, hi2;
+      worldBox(a.sherds[j], lo2, hi2);
+      const double gap = std::max({lo.x() - hi2.x(), lo2.x() - hi.x(), lo.y() - hi2.y(), lo2.y() - hi.y()});
+      EXPECT_GE(gap, 0.012 - 1e-9) << a.sherds[i].name << " vs " << a.sherds[j].name;
+    }
+    const SherdGeometry g = SherdMeshBuilder::build(a.sherds[i]);
+    EXPECT_GT(g.mass, 0.003);   // kg
+    EXPECT_LT(g.mass, 0.120);
+    EXPECT_GE(g.length, 0.02 - 1e-9);
+    EXPECT_LE(g.length, 0.10 + 1e-9);
+    EXPECT_GE(a.sherds[i].density, 1800);
+    EXPECT_LE(a.sherds[i].density, 2000);
+  }
+}
+
+TEST(ScenarioLoader, MassFollowsVolumeTimesDensity) {
+  SherdSpec s;
+  s.name = "slab";
+  s.outline = {{-0.025, -0.02}, {0.025, -0.02}, {0.025, 0.02}, {-0.025, 0.02}};
+  s.thickness = 0.007;
+  s.density = 1800;
+  const SherdGeometry g = SherdMeshBuilder::build(s);
+  // facts sherds_and_colour.md §0: 5 x 4 cm, 7 mm at 1.8 g/cm^3 is about 25 g
+  EXPECT_NEAR(g.mass, 0.05 * 0.04 * 0.007 * 1800, 1e-6);
+}
+
+TEST(ScenarioLoader, LoadsTheFragmentMesh) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  const Scenario s = loader.parse("sherds:\n  - {name: frag, mesh: fragment, pose: [0.1, 0.2, 0], density: 1900}\n");
+  ASSERT_EQ(s.sherds.size(), 1u);
+  const SherdGeometry g = SherdMeshBuilder::build(s.sherds[0]);
+  EXPECT_NEAR(g.volume, 29.6e-6, 0.5e-6);  // data/sherds/SOURCE.md: 29.6 cm^3
+}
+
+TEST(ScenarioLoader, ErrorsNameTheKey) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  try {
+    loader.parse("sherds:\n  - {pose: [0, 0, 0], thickness: 0.5}\n");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("sherds[0].thickness"), std::string::npos) << e.what();
+  }
+  try {
+    loader.parse("lighting: {brightness: 3}\n");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("lighting.brightness"), std::string::npos) << e.what();
+  }
+}

@@ -1,0 +1,65 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rascal_sim/ServoModel.hpp"
+
+using namespace rascal_sim;
+
+TEST(ServoModel, TrajectoryFasterThanLimitsIsFollowedNoFasterThanLimits) {
+  ServoModel servo(JointVector{0, 0, 0, 0, 0, 0});
+  // ask for 2 rad on every joint in 0.1 s (20 rad/s): far beyond pi rad/s and 5 rad/s^2
+  TrajectoryPoint p;
+  p.positions = {2.0, 1.5, -1.5, 2.0, 1.5, -2.0};
+  p.time_from_start = 0.1;
+  servo.setTrajectory(0.0, 0.0, {p}, {true, true, true, true, true, true});
+  const double dt = 0.001;
+  JointVector v_prev = servo.velocities();
+  double vmax = 0, amax = 0, arrived = -1;
+  for (int i = 0; i < 6000; ++i) {
+    servo.step(i * dt, dt);
+    for (int j = 0; j < kArmJoints; ++j) {
+      vmax = std::max(vmax, std::abs(servo.velocities()[j]));
+      amax = std::max(amax, std::abs(servo.velocities()[j] - v_prev[j]) / dt);
+    }
+    v_prev = servo.velocities();
+    if (arrived < 0 && servo.settled()) arrived = (i + 1) * dt;
+  }
+  EXPECT_LE(vmax, ArmKinematics::kMaxVelocity + 1e-9);
+  EXPECT_LE(amax, ArmKinematics::kMaxAcceleration + 1e-6);
+  // 2 rad at pi rad/s and 5 rad/s^2: trapezoid of 2/pi + pi/5 = 1.27 s at the very least
+  ASSERT_GT(arrived, 0);
+  EXPECT_GE(arrived, 2.0 / M_PI + M_PI / 5.0);
+  EXPECT_NEAR(servo.positions()[0], 2.0, 0.01);
+}
+
+TEST(ServoModel, EmptyTrajectoryStopsWithinTheAccelerationLimit) {
+  ServoModel servo(JointVector{0, 0, 0, 0, 0, 0});
+  TrajectoryPoint p;
+  p.positions = {3.0, 0, 0, 0, 0, 0};
+  p.time_from_start = 2.0;
+  servo.setTrajectory(0.0, 0.0, {p}, {true, true, true, true, true, true});
+  double t = 0;
+  for (; t < 0.5; t += 0.001) servo.step(t, 0.001);
+  const double v0 = servo.velocities()[0];
+  EXPECT_GT(v0, 0.5);
+  servo.setTrajectory(t, t, {}, {true, true, true, true, true, true});
+  double prev = v0;
+  for (int i = 0; i < 2000; ++i, t += 0.001) {
+    servo.step(t, 0.001);
+    EXPECT_LE(std::abs(servo.velocities()[0] - prev), 5.0 * 0.001 + 1e-9);
+    prev = servo.velocities()[0];
+  }
+  EXPECT_LT(std::abs(servo.velocities()[0]), 1e-3);
+}
+
+TEST(ServoModel, StaysInsideJointLimits) {
+  ServoModel servo(JointVector{0, 0, 0, 0, 0, 0});
+  TrajectoryPoint p;
+  p.positions = {0, 3.0, 0, 0, 0, 0};  // shoulder upper limit is 1.99 rad
+  p.time_from_start = 1.0;
+  servo.setTrajectory(0.0, 0.0, {p}, {true, true, true, true, true, true});
+  for (int i = 0; i < 3000; ++i) servo.step(i * 0.001, 0.001);
+  EXPECT_LE(servo.positions()[1], ArmKinematics::upperLimits()[1] + 1e-12);
+  EXPECT_NEAR(servo.positions()[1], ArmKinematics::upperLimits()[1], 0.01);
+}
