@@ -33,3 +33,48 @@ def logs():
     smach.set_loggers(smach.log.__dict__['_default_info'], smach.log.__dict__['_default_warn'],
                       smach.log.__dict__['_default_debug'], smach.log.__dict__['_default_error'])
     smach.set_shutdown_check(lambda: False)
+
+
+# --- catalogue fixtures (use the root conftest's `pg_dsn`: a fresh database per test) ---
+PYTHON = '/usr/bin/python3'
+
+
+def subprocess_env():
+    """Environment for a child /usr/bin/python3 that must import rascal_tasks."""
+    import rascal_tasks
+    src = os.path.dirname(os.path.dirname(os.path.abspath(rascal_tasks.__file__)))
+    env = dict(os.environ)
+    env['PYTHONPATH'] = os.pathsep.join(p for p in (src, env.get('PYTHONPATH')) if p)
+    env['PYTHONUNBUFFERED'] = '1'
+    return env
+
+
+class FakeClock:
+    """Deterministic wall clock for record timestamps: +1.25 s per reading."""
+
+    def __init__(self, start=1_790_000_000.0):
+        self.t = start
+
+    def __call__(self):
+        self.t += 1.25
+        return self.t
+
+
+@pytest.fixture
+def migrated_dsn(pg_dsn):
+    import psycopg2
+
+    from rascal_tasks.catalogue import migrate
+    conn = psycopg2.connect(pg_dsn)
+    migrate(conn)
+    conn.close()
+    return pg_dsn
+
+
+@pytest.fixture
+def catalogue(migrated_dsn):
+    from rascal_tasks.catalogue import Catalogue
+    cat = Catalogue.connect(migrated_dsn, rig='test-rig', config_hash='cafe0123',
+                            clock=FakeClock())
+    yield cat
+    cat.close()

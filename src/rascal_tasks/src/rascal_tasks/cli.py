@@ -1,0 +1,212 @@
+"""The ``rascal`` command line (scripts/rascal is a thin wrapper around ``main``).
+
+    rascal db migrate                      apply the catalogue's SQL migrations
+    rascal db status                       show the database and which migrations are applied
+    rascal export --context ID --format csv|json [--output FILE]
+
+The database comes from ``--dsn``, else ``$RASCAL_DSN``, else ``database.dsn`` of the site
+config (``--config``, else ``$RASCAL_CONFIG``, else ``config/rascal.yaml`` of the workspace),
+else the default DSN below. Errors are one line on stderr; exit status 0 = done,
+1 = failed (or, for ``db status``, schema not up to date), 2 = bad arguments or config.
+
+To add a subcommand: write ``_add_<name>(subparsers)`` that creates its parser and sets
+``func``, and call it in ``build_parser``.
+"""
+import argparse
+import os
+import re
+import sys
+import tempfile
+
+DEFAULT_DSN = 'postgresql://rascal:rascal@127.0.0.1:5432/rascal'
+_WORKSPACE_CONFIG = os.path.normpath(os.path.join(
+    os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', '..', 'config', 'rascal.yaml'))
+
+
+class UsageError(Exception):
+    """Bad arguments or configuration (exit status 2)."""
+
+
+def _mask(dsn):
+    """The DSN with its password replaced by ***."""
+    dsn = re.sub(r'(://[^:/@]*:)[^@]*@', r'\1***@', dsn)
+    return re.sub(r'(password\s*=\s*)\S+', r'\1***', dsn)
+
+
+def load_site_config(path):
+    """The validated site config (the lead's loader), or UsageError with its one line."""
+    from rascal_tasks.config import ConfigError, load_config
+    try:
+        return load_config(path)
+    except ConfigError as e:
+        raise UsageError(str(e)) from None
+
+
+def _config_path(args):
+    path = args.config or os.environ.get('RASCAL_CONFIG')
+    if path:
+        return path
+    for candidate in (os.path.join('config', 'rascal.yaml'), _WORKSPACE_CONFIG):
+        if os.path.isfile(candidate):
+            return candidate
+    return None
+
+
+def resolve_database(args):
+    """``(dsn, connect_timeout, where_it_came_from)``."""
+    if args.dsn:
+        return args.dsn, 5.0, '--dsn'
+    if os.environ.get('RASCAL_DSN'):
+        return os.environ['RASCAL_DSN'], 5.0, 'RASCAL_DSN'
+    path = _config_path(args)
+    if path:
+        cfg = load_site_config(path)
+        db = cfg['database']
+        return db['dsn'], float(db.get('connect_timeout', 5.0)), path
+    return DEFAULT_DSN, 5.0, 'default'
+
+
+def connect(args):
+    import psycopg2
+    dsn, timeout, source = resolve_database(args)
+    try:
+        conn = psycopg2.connect(dsn, connect_timeout=max(1, int(round(timeout))),
+                                application_name='rascal-cli')
+    except psycopg2.OperationalError as e:
+        first = (str(e).strip().splitlines() or ['unknown error'])[0]
+        raise RuntimeError('database %s (from %s): cannot connect: %s'
+                           % (_mask(dsn), source, first)) from None
+    return conn, dsn, source
+
+
+# --- db ---
+def cmd_db_migrate(args, out):
+    from rascal_tasks.catalogue import migrate
+    conn, dsn, source = connect(args)
+    try:
+        done = migrate(conn, logger=_PrintLogger(out))
+    finally:
+        conn.close()
+    if done:
+        print('migrated %s to version %d (%d applied)' % (_mask(dsn), done[-1], len(done)),
+              file=out)
+    else:
+        print('%s: already up to date' % _mask(dsn), file=out)
+    return 0
+
+
+def cmd_db_status(args, out):
+    from rascal_tasks.catalogue import status
+    conn, dsn, source = connect(args)
+    try:
+        rows = status(conn)
+        with conn, conn.cursor() as cur:
+            cur.execute('SHOW server_version')
+            version = cur.fetchone()[0]
+            counts = None
+            if rows and rows[0][3] == 'applied':
+                cur.execute('SELECT (SELECT count(*) FROM contexts), (SELECT count(*) FROM sherds)')
+                counts = cur.fetchone()
+    finally:
+        conn.close()
+    print('database  %s (from %s), PostgreSQL %s' % (_mask(dsn), source, version), file=out)
+    for v, name, applied_at, state in rows:
+        when = applied_at.strftime('%Y-%m-%d %H:%M:%S %Z') if applied_at else ''
+        print('  %04d_%-24s %-8s %s' % (v, name, state, when), file=out)
+    if counts is not None:
+        print('contents  %d contexts, %d sherds' % counts, file=out)
+    behind = [r for r in rows if r[3] != 'applied']
+    if behind:
+        print('schema    not up to date: run `rascal db migrate`', file=out)
+        return 1
+    print('schema    up to date', file=out)
+    return 0
+
+
+# --- export ---
+def cmd_export(args, out):
+    from rascal_tasks.catalogue import export_records, to_csv, to_json, validate_context_id
+    from rascal_tasks.catalogue.errors import FieldError
+    try:
+        validate_context_id(args.context)
+    except FieldError as e:
+        raise UsageError(str(e)) from None
+    conn, _, _ = connect(args)
+    try:
+        context, records = export_records(conn, args.context)
+    finally:
+        conn.close()
+    text = to_csv(records) if args.format == 'csv' else to_json(context, records)
+    if args.output in (None, '-'):
+        out.write(text)
+    else:
+        directory = os.path.dirname(os.path.abspath(args.output))
+        fd, tmp = tempfile.mkstemp(prefix='.rascal-export.', dir=directory)
+        try:
+            with os.fdopen(fd, 'w', encoding='utf-8', newline='') as f:
+                f.write(text)
+            os.replace(tmp, args.output)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        print('%d sherds of context %s written to %s' % (len(records), args.context,
+                                                          args.output), file=sys.stderr)
+    return 0
+
+
+class _PrintLogger:
+    def __init__(self, out):
+        self.out = out
+
+    def info(self, msg):
+        print(msg, file=self.out)
+
+    warning = info
+
+
+def _add_db(sub):
+    db = sub.add_parser('db', help='catalogue database: migrate | status')
+    dbsub = db.add_subparsers(dest='db_command', metavar='{migrate,status}')
+    dbsub.required = True
+    dbsub.add_parser('migrate', help='apply the SQL migrations (safe to re-run)').set_defaults(
+        func=cmd_db_migrate)
+    dbsub.add_parser('status', help='show the database and its migrations (exit 1 if behind)'
+                     ).set_defaults(func=cmd_db_status)
+
+
+def _add_export(sub):
+    ex = sub.add_parser('export', help="write a context's sherd records as CSV or JSON")
+    ex.add_argument('--context', required=True, help='context id, e.g. TR1-1023')
+    ex.add_argument('--format', required=True, choices=('csv', 'json'))
+    ex.add_argument('--output', '-o', help='file to write (default: standard output)')
+    ex.set_defaults(func=cmd_export)
+
+
+def build_parser():
+    p = argparse.ArgumentParser(prog='rascal', description='RASCAL: record pottery sherds.')
+    p.add_argument('--config', help='site config (default: $RASCAL_CONFIG or config/rascal.yaml)')
+    p.add_argument('--dsn', help='PostgreSQL DSN (default: $RASCAL_DSN, else database.dsn '
+                   'of the config)')
+    sub = p.add_subparsers(dest='command', metavar='COMMAND')
+    sub.required = True
+    _add_db(sub)
+    _add_export(sub)
+    return p
+
+
+def main(argv=None, out=None):
+    out = out or sys.stdout
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args, out)
+    except UsageError as e:
+        print('rascal: error: %s' % e, file=sys.stderr)
+        return 2
+    except Exception as e:  # one line for the operator; no traceback for expected failures
+        from rascal_tasks.catalogue.errors import CatalogueError
+        if isinstance(e, (CatalogueError, RuntimeError)):
+            print('rascal: error: %s' % e, file=sys.stderr)
+            return 1
+        raise
