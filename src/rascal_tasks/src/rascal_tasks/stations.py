@@ -39,8 +39,9 @@ class StationPlugin:
         """Called with the sherd in the gripper above the station (e.g. tare the scale)."""
 
     def after_place(self, sherd) -> str:
-        """Called with the sherd placed and the gripper back at travel height.
-        Returns 'done', or 'failed' when the measurement could not be taken (recorded anyway)."""
+        """Called with the sherd placed and the gripper back at travel height. Returns 'done',
+        or 'failed' when the station could not do its job: the batch then parks the arm with
+        the catalogue consistent, for a person to look (a restart resumes this sherd)."""
         raise NotImplementedError
 
 
@@ -62,30 +63,36 @@ class ScaleStation(StationPlugin):
                     break
                 self.batch.event(sherd, "scale_unstable", "attempt %d: %.1f g" % (
                     attempt + 1, reading.mass * 1000))
+        if reading.mass <= 0.0:
+            self.batch.event(sherd, "scale_failed", "reads %.1f g with the sherd on it" % (
+                reading.mass * 1000))
+            return "failed"
         sherd.mass = reading.mass
-        self.batch.recorder.record(self.batch.context, sherd.seq, status=self.status,
-                                   mass=reading.mass, mass_stable=reading.stable)
-        return "done" if reading.stable else "failed"
+        # An unstable last reading is still recorded, and flagged in the sherd's notes.
+        self.batch.recorder.mass(sherd.seq, reading.mass, reading.stable)
+        return "done"
 
 
 @station_type("archival_camera")
 class ArchivalCameraStation(StationPlugin):
     status = "photographed"
+    CAPTURE_ATTEMPTS = 3
 
     def after_place(self, sherd):
         b = self.batch
         standby = b.config["arm"]["standby"]
         b.move_down(standby[0], standby[1], b.config["arm"]["travel_z"], sherd.grasp_yaw)
         with b.phase("data_collection"):
-            try:
-                spool = b.archive.spool_path(b.context, sherd.seq)
-                capture = b.rig.camera.capture(spool)
-            except RigError as e:
-                b.event(sherd, "capture_failed", e.reason)
+            for attempt in range(self.CAPTURE_ATTEMPTS):
+                try:
+                    capture = b.rig.camera.capture(b.recorder.spool_path(sherd.seq))
+                    break
+                except RigError as e:
+                    b.event(sherd, "capture_failed", "attempt %d: %s" % (attempt + 1, e.reason))
+                    b.rig.clock.sleep(1.0)
+            else:
                 return "failed"
-            path, sha256 = b.archive.store(b.context, sherd.seq, capture.path, sherd.record())
-        b.recorder.record(b.context, sherd.seq, status=self.status, image_path=path,
-                          image_sha256=sha256)
+            b.recorder.photo(sherd.seq, capture.path)
         return "done"
 
 
@@ -95,6 +102,5 @@ class DiscardStation(StationPlugin):
     release_from_above = True
 
     def after_place(self, sherd):
-        self.batch.recorder.record(self.batch.context, sherd.seq, status=self.status,
-                                   drops=sherd.drops, timings=sherd.timings.as_dict())
+        self.batch.recorder.done(sherd.seq, timings=sherd.timings.as_dict())
         return "done"

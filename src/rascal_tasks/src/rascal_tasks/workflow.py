@@ -59,12 +59,11 @@ class BatchAborted(Exception):
 class Batch:
     """Everything the states share: config, rig, recorder, archive, and the sherd in hand."""
 
-    def __init__(self, config, rig: Rig, recorder, archive, context: str,
+    def __init__(self, config, rig: Rig, recorder, context: str,
                  progress: Optional[Callable[[str], None]] = None, log=None):
         self.config = config
         self.rig = rig
-        self.recorder = recorder
-        self.archive = archive
+        self.recorder = recorder  # rascal_tasks.recorder.Recorder, bound to `context`
         self.context = context
         self.progress = progress or (lambda state: None)
         self.log = log or (lambda msg: None)
@@ -90,8 +89,10 @@ class Batch:
                 self.sherd.timings.add(name, self.rig.clock.now() - t0)
 
     def event(self, sherd, kind: str, detail: str = ""):
+        """Log what happened; a sherd's events also go into its catalogue notes."""
         self.log("%s %s: %s" % ("sherd %d" % sherd.seq if sherd else "batch", kind, detail))
-        self.recorder.event(self.context, sherd.seq if sherd else None, kind, detail)
+        if sherd is not None:
+            self.recorder.note(sherd.seq, "%s: %s" % (kind, detail))
 
     def move_down(self, x, y, z, yaw, linear=False):
         with self.phase("locomotion"):
@@ -202,7 +203,7 @@ class Resume(BatchState):
 
     def run(self):
         b = self.batch
-        rows = b.recorder.unfinished(b.context)
+        rows = b.recorder.unfinished()
         if not rows:
             return "SURVEY"
         seq, status = rows[0]
@@ -225,7 +226,7 @@ class Resume(BatchState):
                                           o.width, station_index=done, where=st.name,
                                           last_xy=(o.x, o.y))
                 return ("REPICK_%d" if i == done else "STATION_%d") % i
-        b.recorder.lost(b.context, seq, "not found after restart (was %s)" % status)
+        b.recorder.lost(seq, "not found after restart (was %s)" % status)
         b.lost += 1
         return "SURVEY"
 
@@ -267,11 +268,10 @@ class Pickup(BatchState):
         attempts = b.config["recovery"]["max_grasp_attempts"]
         for attempt in range(attempts):
             if grasp(b, o, b.pickup.surface_z):
-                seq = b.recorder.new_sherd(b.context)
+                seq = b.recorder.new_sherd((o.x, o.y), attempts=attempt + 1)
                 b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - b.pickup.surface_z,
                                           o.width, last_xy=(o.x, o.y))
-                b.recorder.record(b.context, seq, length=o.length, width=o.width,
-                                  thickness=o.height, colour=o.colour)
+                b.recorder.dimensions(seq, o.length, o.width, o.height)
                 return "held"
             seen = b.survey_at(b.pickup, o.x, o.y)
             near = [s for s in seen if s.distance_to(o.x, o.y) < b.config["recovery"][
@@ -323,7 +323,7 @@ class Translate(BatchState):
 def dropped(b: Batch, where: str) -> str:
     b.sherd.drops += 1
     b.event(b.sherd, "dropped", where)
-    b.recorder.record(b.context, b.sherd.seq, drops=b.sherd.drops)
+    b.recorder.drop(b.sherd.seq, where)
     return "dropped"
 
 
@@ -364,9 +364,9 @@ class AtStation(BatchState):
 
     def run(self):
         b = self.batch
-        outcome = b.plugins[self.index].after_place(b.sherd)
-        if outcome != "done":
+        if b.plugins[self.index].after_place(b.sherd) != "done":
             b.event(b.sherd, "station_failed", b.station_names[self.index])
+            return "aborted"
         b.sherd.station_index = self.index
         if self.index == len(b.plugins) - 1:
             b.completed += 1
@@ -393,7 +393,7 @@ class Repick(BatchState):
                             st.surface_z + s.grasp_height, s.grasp_yaw,
                             opening_for(s.width, b.config["arm"]["grasp_margin"]))
         o = blind
-        for attempt in range(b.config["recovery"]["max_grasp_attempts"]):
+        for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
             if grasp(b, o, st.surface_z):
                 return "held"
             seen = b.survey_at(st, x, y)
@@ -407,7 +407,7 @@ class Repick(BatchState):
 
 def lose(b: Batch, reason: str) -> str:
     b.event(b.sherd, "lost", reason)
-    b.recorder.lost(b.context, b.sherd.seq, reason)
+    b.recorder.lost(b.sherd.seq, reason)
     b.lost += 1
     b.sherd = None
     return "lost"
@@ -458,45 +458,42 @@ def park(b: Batch):
 
 
 def build_machine(batch: Batch):
-    """The state machine for one batch; outcomes: finished, preempted, aborted."""
+    """The state machine for one batch; outcomes: finished, preempted, aborted.
+
+    States are numbered by the station's place in the config (TRANSLATE_0 goes to the first
+    station after pickup); any state that is preempted or aborts goes through a PARK state."""
     sm = smach.StateMachine(outcomes=["finished", "preempted", "aborted"])
     n = len(batch.plugins)
     fail = {"preempted": "PARK_PREEMPTED", "aborted": "PARK_ABORTED"}
 
-    def next_after(i):
-        return "TRANSLATE_%d" % (i + 1) if i + 1 < n else "SURVEY"
+    def add(label, state, **transitions):
+        smach.StateMachine.add(label, state, {**transitions, **fail}
+                               if not label.startswith("PARK") else transitions)
 
     with sm:
-        smach.StateMachine.add("HOME", Home(batch), dict(done="CALIBRATE", **fail))
-        smach.StateMachine.add("CALIBRATE", Calibrate(batch), dict(done="RESUME", **fail))
+        add("HOME", Home(batch), done="CALIBRATE")
+        add("CALIBRATE", Calibrate(batch), done="RESUME")
         resume = Resume(batch)
-        smach.StateMachine.add("RESUME", resume, dict(
-            {o: o for o in resume.get_registered_outcomes()
-             if o not in ("preempted", "aborted")}, **fail))
-        smach.StateMachine.add("SURVEY", Survey(batch), dict(found="PICKUP", empty="PARK", **fail))
-        smach.StateMachine.add("PICKUP", Pickup(batch),
-                               dict(held="TRANSLATE_0", missed="SURVEY", **fail))
+        add("RESUME", resume, **{o: o for o in resume.get_registered_outcomes()
+                                 if o not in fail})
+        add("SURVEY", Survey(batch), found="PICKUP", empty="PARK")
+        add("PICKUP", Pickup(batch), held="TRANSLATE_0", missed="SURVEY")
         for i in range(n):
             last = i == n - 1
-            smach.StateMachine.add("TRANSLATE_%d" % i, Translate(batch, i),
-                                   dict(arrived="PLACE_%d" % i, dropped="RECOVER_%d" % i, **fail))
-            smach.StateMachine.add("PLACE_%d" % i, Place(batch, i),
-                                   dict(placed="STATION_%d" % i, **fail))
-            smach.StateMachine.add("STATION_%d" % i, AtStation(batch, i),
-                                   dict(done="SURVEY_NEXT" if last else "REPICK_%d" % i, **fail))
+            add("TRANSLATE_%d" % i, Translate(batch, i),
+                arrived="PLACE_%d" % i, dropped="RECOVER_%d" % i)
+            add("PLACE_%d" % i, Place(batch, i), placed="STATION_%d" % i)
+            add("STATION_%d" % i, AtStation(batch, i),
+                done="SURVEY_NEXT" if last else "REPICK_%d" % i)
             if not last:
-                smach.StateMachine.add("REPICK_%d" % i, Repick(batch, i),
-                                       dict(held=next_after(i), lost="SURVEY_NEXT", **fail))
-            smach.StateMachine.add("RECOVER_%d" % i, Recover(batch),
-                                   dict(held="TRANSLATE_%d" % i, lost="SURVEY_NEXT", **fail))
-        smach.StateMachine.add("SURVEY_NEXT", _Next(batch),
-                               dict(pickup="PICKUP", survey="SURVEY", **fail))
-        smach.StateMachine.add("PARK", Park(batch), dict(done="finished", aborted="aborted",
-                                                         preempted="preempted"))
-        smach.StateMachine.add("PARK_PREEMPTED", Park(batch),
-                               dict(done="preempted", aborted="aborted", preempted="preempted"))
-        smach.StateMachine.add("PARK_ABORTED", Park(batch),
-                               dict(done="aborted", aborted="aborted", preempted="aborted"))
+                add("REPICK_%d" % i, Repick(batch, i),
+                    held="TRANSLATE_%d" % (i + 1), lost="SURVEY_NEXT")
+            add("RECOVER_%d" % i, Recover(batch), held="TRANSLATE_%d" % i, lost="SURVEY_NEXT")
+        add("SURVEY_NEXT", _Next(batch), pickup="PICKUP", survey="SURVEY")
+        add("PARK", Park(batch), done="finished", aborted="aborted", preempted="preempted")
+        add("PARK_PREEMPTED", Park(batch), done="preempted", aborted="aborted",
+            preempted="preempted")
+        add("PARK_ABORTED", Park(batch), done="aborted", aborted="aborted", preempted="aborted")
     return sm
 
 
