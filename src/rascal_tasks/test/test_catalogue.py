@@ -35,7 +35,9 @@ def full_sherd(cat, archive, context='TR1-1023'):
                       colour_lab=(62.5, 21.25, 30.125), chart_delta_e00=1.7, px_per_cm=21.3,
                       t_photo_s=8.0)
     cat.add_note(s['sherd_id'], 'rim, burnt edge')
-    cat.record_done(s['sherd_id'], t_discard_s=5.5)
+    cat.record_done(s['sherd_id'], t_discard_s=5.5,
+                    timings={'locomotion': 21.5, 'grasping': 9.25, 'data_collection': 4.5,
+                             'perception': 1.125})
     return s
 
 
@@ -287,6 +289,21 @@ def test_bad_photo_fields_are_refused(catalogue, kwargs, field):
     assert catalogue.get(s)['status'] == 'weighed'
 
 
+@pytest.mark.parametrize('timings, why', [
+    ({'teleport': 1.0}, "unknown phase 'teleport'"),
+    ({'grasping': -1.0}, r'timings\[grasping\]'),
+    ([1, 2], 'must be a dict'),
+])
+def test_bad_timings_are_refused(catalogue, tmp_path, timings, why):
+    catalogue.open_context('C1', 'site')
+    s = catalogue.new_sherd('C1')['sherd_id']
+    catalogue.record_mass(s, 20.0)
+    catalogue.archive_photo(s, ImageArchive(str(tmp_path)), PNG)
+    with pytest.raises(FieldError, match=why):
+        catalogue.record_done(s, timings=timings)
+    assert catalogue.get(s)['status'] == 'photographed'
+
+
 def test_unknown_sherd_id_is_a_field_error(catalogue):
     with pytest.raises(FieldError, match='no such sherd'):
         catalogue.record_mass(999, 1.0)
@@ -319,7 +336,8 @@ def test_export_round_trips_every_field(catalogue, tmp_path):
     catalogue.open_context('TR1-1023', 'site-7')
     full_sherd(catalogue, archive)
     lost = catalogue.new_sherd('TR1-1023', pickup_xy=(0.2, 0.3))
-    catalogue.record_lost(lost['sherd_id'], 'not found after 2 searches')
+    catalogue.record_lost(lost['sherd_id'], 'not found after 2 searches',
+                          timings={'locomotion': 3.0})
     unfinished = catalogue.new_sherd('TR1-1023')
     catalogue.record_mass(unfinished['sherd_id'], 3.25)
 
@@ -344,7 +362,9 @@ def test_export_round_trips_every_field(catalogue, tmp_path):
     first = from_csv[0]
     assert first['mass_g'] == 25.3 and first['colour_b'] == 30.125
     assert first['notes'] == 'rim, burnt edge' and first['find_id'] == 'TR1-1023-1'
+    assert first['t_grasping_s'] == 9.25 and first['t_perception_s'] == 1.125
     assert from_csv[1]['lost_reason'] == 'not found after 2 searches'
+    assert from_csv[1]['t_locomotion_s'] == 3.0 and from_csv[1]['t_grasping_s'] is None
     assert from_csv[2]['status'] == 'weighed' and from_csv[2]['image_path'] is None
 
 

@@ -26,7 +26,8 @@ from psycopg2 import sql
 from . import migrate as _migrate
 from .context_id import validate_context_id, validate_site_id
 from .errors import CatalogueError, FieldError, StatusError
-from .fields import (check_count, check_munsell, check_number, check_sha256, check_text)
+from .fields import (check_count, check_munsell, check_number, check_sha256, check_text,
+                     check_timings)
 
 __all__ = ['Catalogue', 'SOFTWARE_VERSION']
 
@@ -38,7 +39,8 @@ _SHERD_COLUMNS = (
     'sherd_id, s.context_id, c.site_id, seq, status::text AS status, mass_g, length_mm, '
     'width_mm, thickness_mm, colour_munsell, colour_l, colour_a, colour_b, chart_delta_e00, '
     'px_per_cm, image_path, image_sha256, drops, grasp_attempts, pickup_x_m, pickup_y_m, '
-    't_pick_s, t_weigh_s, t_photo_s, t_discard_s, lost_reason, notes, rig, software_version, '
+    't_pick_s, t_weigh_s, t_photo_s, t_discard_s, t_locomotion_s, t_grasping_s, '
+    't_data_collection_s, t_perception_s, lost_reason, notes, rig, software_version, '
     'config_hash, picked_at, weighed_at, photographed_at, done_at, lost_at, updated_at')
 
 
@@ -278,20 +280,22 @@ class Catalogue:
         rel, sha = archive.store(rec['context_id'], rec['seq'], image, sidecar)
         return self.record_photo(sherd_id, rel, sha, **photo)
 
-    def record_done(self, sherd_id, t_discard_s=None):
-        """The sherd is in the discard box; photographed -> done (final)."""
-        t_discard_s = check_number('t_discard_s', t_discard_s, 0.0, 1e6, 's')
-        return self._advance(sherd_id, 'done', ('photographed',),
-                             {'t_discard_s': t_discard_s}, 'done')
+    def record_done(self, sherd_id, t_discard_s=None, timings=None):
+        """The sherd is in the discard box; photographed -> done (final). ``timings`` is
+        ``{phase: seconds}`` for the phases in ``fields.PHASES`` (the paper's breakdown)."""
+        f = {'t_discard_s': check_number('t_discard_s', t_discard_s, 0.0, 1e6, 's')}
+        f.update(check_timings('timings', timings))
+        return self._advance(sherd_id, 'done', ('photographed',), f, 'done')
 
-    def record_lost(self, sherd_id, reason):
+    def record_lost(self, sherd_id, reason, timings=None):
         """The sherd could not be found again; any unfinished state -> lost (final)."""
         reason = check_text('reason', reason, 500, allow_none=False)
         if not reason.strip():
             raise FieldError("reason '': must say why the sherd is lost (e.g. 'dropped off the "
                              "table')")
-        return self._advance(sherd_id, 'lost', UNFINISHED, {'lost_reason': reason}, 'lost',
-                             {'reason': reason})
+        f = {'lost_reason': reason}
+        f.update(check_timings('timings', timings))
+        return self._advance(sherd_id, 'lost', UNFINISHED, f, 'lost', {'reason': reason})
 
     def record_drop(self, sherd_id, station=None):
         """The sherd slipped from the gripper (counted; no state change)."""

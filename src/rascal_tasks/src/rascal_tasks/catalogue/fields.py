@@ -8,10 +8,12 @@ import re
 
 from .errors import FieldError
 
-__all__ = ['COLUMNS', 'COLUMN_TYPES', 'STATUSES', 'check_number', 'check_count', 'check_text',
-           'check_sha256', 'check_munsell']
+__all__ = ['COLUMNS', 'COLUMN_TYPES', 'STATUSES', 'PHASES', 'check_timings', 'check_number',
+           'check_count', 'check_text', 'check_sha256', 'check_munsell']
 
 STATUSES = ('picked', 'weighed', 'photographed', 'done', 'lost')
+# the paper's breakdown of the time per sherd (columns t_<phase>_s)
+PHASES = ('locomotion', 'grasping', 'data_collection', 'perception')
 
 # (export column, type, description). Types: text, int, float, timestamp.
 COLUMNS = [
@@ -40,6 +42,10 @@ COLUMNS = [
     ('t_weigh_s', 'float', 'time to weigh it [s]'),
     ('t_photo_s', 'float', 'time to photograph it [s]'),
     ('t_discard_s', 'float', 'time to put it in the discard box [s]'),
+    ('t_locomotion_s', 'float', 'time spent moving the arm, all stations [s]'),
+    ('t_grasping_s', 'float', 'time spent grasping and releasing [s]'),
+    ('t_data_collection_s', 'float', 'time spent weighing and photographing [s]'),
+    ('t_perception_s', 'float', 'time spent detecting [s]'),
     ('lost_reason', 'text', 'why it was recorded as lost'),
     ('notes', 'text', 'free text'),
     ('rig', 'text', 'rig that recorded it'),
@@ -112,3 +118,18 @@ def check_munsell(field, value):
         raise FieldError("%s %r: must be Munsell notation 'hue value/chroma' such as "
                          "'2.5YR 6/8' or a neutral such as 'N5'" % (field, value))
     return value
+
+
+def check_timings(field, timings):
+    """``{phase: seconds}`` -> ``{'t_<phase>_s': float}``; phases from PHASES."""
+    if timings is None:
+        return {}
+    if not isinstance(timings, dict):
+        raise FieldError('%s %r: must be a dict of seconds per phase (%s)'
+                         % (field, timings, ', '.join(PHASES)))
+    out = {}
+    for phase, seconds in timings.items():
+        if phase not in PHASES:
+            raise FieldError("%s: unknown phase %r (use %s)" % (field, phase, ', '.join(PHASES)))
+        out['t_%s_s' % phase] = check_number('%s[%s]' % (field, phase), seconds, 0.0, 1e6, 's')
+    return out
