@@ -1,0 +1,154 @@
+"""rascal_control.Arm: move the arm by pose, named pose or joints through /rascal/arm/move."""
+import math
+from typing import Optional, Sequence
+
+from rascal_control.results import OK, MoveResult, Timeout, ik_error, move_error
+
+ARM_JOINTS = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
+MOTIONS = {"joint": 0, "linear": 1}
+
+
+def quaternion_from_rpy(roll: float, pitch: float, yaw: float):
+    """(x, y, z, w) of R = Rz(yaw) Ry(pitch) Rx(roll) (static XYZ, as Interbotix uses)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+def to_pose_stamped(pose):
+    """PoseStamped in base_link from a PoseStamped, a Pose, (x, y, z, roll, pitch, yaw) or
+    (x, y, z, qx, qy, qz, qw)."""
+    from geometry_msgs.msg import Pose, PoseStamped
+    if isinstance(pose, PoseStamped):
+        if not pose.header.frame_id:
+            pose.header.frame_id = "base_link"
+        return pose
+    out = PoseStamped()
+    out.header.frame_id = "base_link"
+    if isinstance(pose, Pose):
+        out.pose = pose
+        return out
+    values = [float(v) for v in pose]
+    if len(values) == 6:
+        quat = quaternion_from_rpy(*values[3:])
+    elif len(values) == 7:
+        quat = values[3:]
+    else:
+        raise ValueError("a pose is a PoseStamped, a Pose, (x, y, z, roll, pitch, yaw) or "
+                         "(x, y, z, qx, qy, qz, qw); got %d numbers" % len(values))
+    out.pose.position.x, out.pose.position.y, out.pose.position.z = values[:3]
+    (out.pose.orientation.x, out.pose.orientation.y, out.pose.orientation.z,
+     out.pose.orientation.w) = quat
+    return out
+
+
+class Arm:
+    """PyRobot-like arm client. Needs rospy.init_node() first (unless clients are injected).
+
+    Every move returns a MoveResult or raises Unreachable, Collision, Timeout, Preempted or
+    InvalidGoal with the controller's one-line reason.
+    """
+
+    def __init__(self, move_client=None, ik_service=None, fk_service=None, wait: float = 10.0):
+        if move_client is None:
+            import actionlib
+            import rospy
+            from rascal_msgs.msg import MoveArmAction
+            from rascal_msgs.srv import ComputeFK, ComputeIK
+            move_client = actionlib.SimpleActionClient("/rascal/arm/move", MoveArmAction)
+            if not move_client.wait_for_server(rospy.Duration(wait)):
+                raise Timeout(3, "no /rascal/arm/move action server within %.0f s; is "
+                                 "arm_controller running?" % wait)
+            ik_service = rospy.ServiceProxy("/rascal/arm/compute_ik", ComputeIK)
+            fk_service = rospy.ServiceProxy("/rascal/arm/compute_fk", ComputeFK)
+        self._move = move_client
+        self._ik = ik_service
+        self._fk = fk_service
+        self.last_result: Optional[MoveResult] = None
+
+    # -- goals ------------------------------------------------------------------------------
+    @staticmethod
+    def top_down(x: float, y: float, z: float, yaw: float = 0.0):
+        """ee_gripper_link pointing straight down at (x, y, z), turned by `yaw` about z."""
+        return to_pose_stamped((x, y, z, 0.0, math.pi / 2, yaw))
+
+    def move_to(self, pose, motion: str = "joint", speed_scale: float = 1.0,
+                timeout: Optional[float] = None) -> MoveResult:
+        """Move ee_gripper_link to `pose` (see to_pose_stamped) by a joint or linear motion."""
+        goal = self._goal(motion, speed_scale)
+        goal.target_type = goal.TARGET_POSE
+        goal.pose = to_pose_stamped(pose)
+        return self._run(goal, timeout)
+
+    def go(self, name: str, motion: str = "joint", speed_scale: float = 1.0,
+           timeout: Optional[float] = None) -> MoveResult:
+        """Move to a named pose of the config (arm/named_poses), e.g. "home", "sleep"."""
+        goal = self._goal(motion, speed_scale)
+        goal.target_type = goal.TARGET_NAMED
+        goal.named_pose = name
+        return self._run(goal, timeout)
+
+    def move_joints(self, joints: Sequence[float], motion: str = "joint", speed_scale: float = 1.0,
+                    timeout: Optional[float] = None) -> MoveResult:
+        """Move to a joint vector [rad]: waist, shoulder, elbow, forearm_roll, wrist_angle,
+        wrist_rotate."""
+        goal = self._goal(motion, speed_scale)
+        goal.target_type = goal.TARGET_JOINTS
+        goal.joints = [float(j) for j in joints]
+        return self._run(goal, timeout)
+
+    def stop(self):
+        """Cancel the current move; the controller stops the arm."""
+        self._move.cancel_all_goals()
+
+    # -- kinematics -------------------------------------------------------------------------
+    def compute_ik(self, pose, seed: Optional[Sequence[float]] = None):
+        """Joint vector for `pose`, closest to `seed` (default: the current joints)."""
+        response = self._ik(to_pose_stamped(pose), list(seed or []))
+        if response.code != OK:
+            raise ik_error(response.code, response.message)
+        return list(response.joints)
+
+    def compute_fk(self, joints: Optional[Sequence[float]] = None, link: str = ""):
+        """PoseStamped of `link` (default ee_gripper_link) in base_link; joints default to the
+        current ones."""
+        response = self._fk(list(joints or []), link)
+        if not response.success:
+            raise move_error(5, response.message)
+        return response.pose
+
+    def get_ee_pose(self):
+        """Current PoseStamped of ee_gripper_link."""
+        return self.compute_fk()
+
+    # -- internals --------------------------------------------------------------------------
+    @staticmethod
+    def _goal(motion: str, speed_scale: float):
+        from rascal_msgs.msg import MoveArmGoal
+        if motion not in MOTIONS:
+            raise ValueError("motion must be 'joint' or 'linear', not %r" % (motion,))
+        if not 0.0 < speed_scale <= 1.0:
+            raise ValueError("speed_scale must be in (0, 1], not %r" % (speed_scale,))
+        goal = MoveArmGoal()
+        goal.motion = MOTIONS[motion]
+        goal.speed_scale = float(speed_scale)
+        return goal
+
+    def _run(self, goal, timeout: Optional[float]) -> MoveResult:
+        import rospy
+        self._move.send_goal(goal)
+        finished = self._move.wait_for_result(rospy.Duration(timeout or 0.0))
+        if not finished:
+            self._move.cancel_goal()
+            raise Timeout(3, "no result from /rascal/arm/move within %.1f s; move cancelled"
+                          % timeout)
+        msg = self._move.get_result()
+        if msg is None:
+            raise Timeout(3, "/rascal/arm/move ended without a result (controller gone?)")
+        result = MoveResult(msg.code, msg.message, msg.duration, list(msg.joints))
+        self.last_result = result
+        if msg.code != OK:
+            raise move_error(msg.code, msg.message, result)
+        return result

@@ -1,0 +1,159 @@
+"""Wiring tests of the arm_controller node (a master on a free port, nodes started with rosrun).
+
+Without a driver: parameter errors, the IK/FK services, goals failing cleanly.
+Against the simulator (`rosrun rascal_sim sim`, skipped until rascal_sim is built): a pose goal
+arrives within 2 mm, an unreachable goal returns UNREACHABLE within 1 s without moving the arm,
+a cancelled move stops, and the gripper reports held on a sherd and not held on nothing.
+"""
+import json
+import math
+import os
+import subprocess
+import time
+
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
+CONFIG = os.path.join(WORKSPACE, "config", "rascal.yaml")
+CLIENT = os.path.join(HERE, "wiring_client.py")
+
+
+def built(package, executable):
+    try:
+        out = subprocess.run(["catkin_find", "--first-only", package, executable],
+                             capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    return out.returncode == 0 and bool(out.stdout.strip())
+
+
+requires_controller = pytest.mark.skipif(
+    not built("rascal_control", "arm_controller"),
+    reason="arm_controller not built (build the workspace and source devel/setup.bash)")
+requires_sim = pytest.mark.skipif(
+    not built("rascal_sim", "sim"),
+    reason="rascal_sim is not built yet; these run against `rosrun rascal_sim sim`")
+
+
+def wait_for(master, what, name, timeout=30.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        out = master.run(["ros" + what, "list"], check=False)
+        if name in out.stdout.split():
+            return
+        time.sleep(0.2)
+    raise AssertionError("%s %s did not appear" % (what, name))
+
+
+def call(master, service, request):
+    out = master.run(["rosservice", "call", service, request], check=True)
+    import yaml
+    return yaml.safe_load(out.stdout)
+
+
+def start_controller(ros_master, rosrun):
+    proc = rosrun("rascal_control", "arm_controller")
+    wait_for(ros_master, "service", "/rascal/arm/compute_fk")
+    return proc
+
+
+@requires_controller
+def test_bad_parameter_names_the_key(ros_master, rosrun):
+    ros_master.run(["rosparam", "load", CONFIG])
+    ros_master.run(["rosparam", "set", "/arm/named_poses/home", "[0.0, 0.0]"])
+    proc = rosrun("rascal_control", "arm_controller")
+    out, _ = proc.communicate(timeout=30)
+    assert proc.returncode != 0
+    lines = [line for line in out.splitlines() if "FATAL" in line]
+    assert len(lines) == 1 and "/arm/named_poses/home" in lines[0], out
+
+
+@requires_controller
+def test_missing_config_names_the_key(ros_master, rosrun):
+    proc = rosrun("rascal_control", "arm_controller")
+    out, _ = proc.communicate(timeout=30)
+    assert proc.returncode != 0 and "/arm/named_poses" in out, out
+
+
+@requires_controller
+def test_bad_fixture_names_the_key(ros_master, rosrun):
+    ros_master.run(["rosparam", "load", CONFIG])
+    ros_master.run(["rosparam", "set", "/stations/camera/stand/height", "-1"])
+    proc = rosrun("rascal_control", "arm_controller")
+    out, _ = proc.communicate(timeout=30)
+    assert proc.returncode != 0 and "/stations/camera/stand/height" in out, out
+
+
+@requires_controller
+def test_services_without_a_driver(ros_master, rosrun):
+    ros_master.run(["rosparam", "load", CONFIG])
+    start_controller(ros_master, rosrun)
+    fk = call(ros_master, "/rascal/arm/compute_fk", "{joints: [0, 0, 0, 0, 0, 0], link: ''}")
+    assert fk["success"]
+    p = fk["pose"]["pose"]["position"]
+    assert (p["x"], p["y"], p["z"]) == pytest.approx((0.458325, 0.0, 0.36065), abs=1e-9)
+    cam = call(ros_master, "/rascal/arm/compute_fk",
+               "{joints: [0, 0, 0, 0, 0, 0], link: camera_color_optical_frame}")
+    assert cam["success"] and cam["pose"]["pose"]["position"]["z"] == pytest.approx(0.41565)
+    bad = call(ros_master, "/rascal/arm/compute_fk", "{joints: [0, 0], link: ''}")
+    assert not bad["success"] and "expected 6" in bad["message"]
+    # A top-down pose: the solution reaches it.
+    s = math.sqrt(0.5)
+    ik = call(ros_master, "/rascal/arm/compute_ik",
+              "{pose: {header: {frame_id: base_link}, pose: {position: {x: 0.3, y: 0.1, z: 0.1}, "
+              "orientation: {x: 0, y: %r, z: 0, w: %r}}}, seed: [0, 0, 0, 0, 0, 0]}" % (s, s))
+    assert ik["code"] == 0, ik["message"]
+    back = call(ros_master, "/rascal/arm/compute_fk", "{joints: %s, link: ''}" % ik["joints"])
+    p = back["pose"]["pose"]["position"]
+    assert (p["x"], p["y"], p["z"]) == pytest.approx((0.3, 0.1, 0.1), abs=1e-6)
+    far = call(ros_master, "/rascal/arm/compute_ik",
+               "{pose: {header: {frame_id: base_link}, pose: {position: {x: 1.3, y: 0, z: 0.1}, "
+               "orientation: {w: 1}}}, seed: [0, 0, 0, 0, 0, 0]}")
+    assert far["code"] == 1 and "out of reach" in far["message"]
+    other = call(ros_master, "/rascal/arm/compute_ik",
+                 "{pose: {header: {frame_id: camera_link}, pose: {orientation: {w: 1}}}, seed: []}")
+    assert other["code"] == 4 and "base_link" in other["message"]
+
+
+@requires_controller
+@requires_sim
+class TestAgainstTheSimulator:
+    @pytest.fixture
+    def rig(self, ros_master, rosrun):
+        ros_master.run(["rosparam", "load", CONFIG])
+        ros_master.run(["rosparam", "set", "/use_sim_time", "true"])
+        ros_master.run(["rosparam", "set", "/simulator/real_time_factor", "1.0"])
+        ros_master.run(["rosparam", "set", "/simulator/wrist_camera", "false"])
+        rosrun("rascal_sim", "sim")
+        wait_for(ros_master, "topic", "/joint_states")
+        start_controller(ros_master, rosrun)
+        return ros_master
+
+    def client(self, rig, scenario, timeout=120):
+        out = subprocess.run(["/usr/bin/python3", CLIENT, scenario], env=rig.env, text=True,
+                             capture_output=True, timeout=timeout)
+        lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
+        assert out.returncode == 0 and lines, out.stdout + out.stderr
+        return json.loads(lines[-1])
+
+    def test_pose_goal_arrives_within_2_mm(self, rig):
+        out = self.client(rig, "pose_goal")
+        assert "error" not in out, out
+        assert out["joint_error"] < 0.002 and out["linear_error"] < 0.002, out
+
+    def test_unreachable_goal_fails_fast_and_does_not_move(self, rig):
+        out = self.client(rig, "unreachable")
+        assert out["error"] == "Unreachable" and out["code"] == 1, out
+        assert out["seconds"] < 1.0 and out["moved"] < 1e-3, out
+
+    def test_cancelled_move_stops(self, rig):
+        out = self.client(rig, "cancel")
+        assert out["code"] == 4, out
+        assert 0.0 < out["waist"] < 2.4 and out["drift"] < 1e-3, out
+
+    def test_gripper_reports_held_on_a_sherd_and_not_on_nothing(self, rig):
+        out = self.client(rig, "grasp")
+        assert "error" not in out, out
+        assert out["held"] and not out["empty"], out
+        assert out["held_width"] > 0.032 and out["empty_width"] < 0.032, out

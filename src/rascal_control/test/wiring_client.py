@@ -1,0 +1,114 @@
+#!/usr/bin/python3
+"""Test helper for test_arm_controller.py: runs one scenario against a live arm_controller with the
+rascal_control Python client, in its own process (rospy can init only once per process), and
+prints one JSON line. Usage: wiring_client.py <scenario>"""
+import json
+import math
+import sys
+import time
+
+import rospy
+from sensor_msgs.msg import JointState
+
+from rascal_control import Arm, ControlError, Gripper
+
+ARM = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
+
+
+def joints():
+    msg = rospy.wait_for_message("/joint_states", JointState, timeout=10.0)
+    pos = dict(zip(msg.name, msg.position, strict=False))
+    return [pos[n] for n in ARM]
+
+
+def error_dict(e):
+    return {"error": type(e).__name__, "code": e.code, "message": e.message}
+
+
+def pose_error(arm, x, y, z):
+    p = arm.get_ee_pose().pose.position
+    return math.dist((p.x, p.y, p.z), (x, y, z))
+
+
+def pose_goal(arm):
+    arm.move_to(Arm.top_down(0.30, 0.10, 0.15, yaw=0.3))
+    time.sleep(0.2)
+    first = pose_error(arm, 0.30, 0.10, 0.15)
+    arm.move_to(Arm.top_down(0.25, -0.05, 0.10, yaw=-0.2), motion="linear")
+    time.sleep(0.2)
+    return {"joint_error": first, "linear_error": pose_error(arm, 0.25, -0.05, 0.10)}
+
+
+def unreachable(arm):
+    before = joints()
+    start = time.monotonic()
+    try:
+        arm.move_to(Arm.top_down(1.0, 0.0, 0.15))
+        out = {"error": None}
+    except ControlError as e:
+        out = error_dict(e)
+    out["seconds"] = time.monotonic() - start
+    rospy.sleep(0.3)
+    out["moved"] = max(abs(a - b) for a, b in zip(before, joints(), strict=True))
+    return out
+
+
+def cancel(arm):
+    arm.go("home")
+    client = arm._move  # the goal is sent asynchronously so it can be cancelled mid-way
+    from rascal_msgs.msg import MoveArmGoal
+    goal = MoveArmGoal(target_type=MoveArmGoal.TARGET_JOINTS, joints=[2.5, 0.3, 0.3, 0, 1.0, 0],
+                       motion=MoveArmGoal.MOTION_JOINT, speed_scale=0.3)
+    client.send_goal(goal)
+    rospy.sleep(0.6)
+    client.cancel_goal()
+    client.wait_for_result(rospy.Duration(10.0))
+    result = client.get_result()
+    rospy.sleep(0.5)  # braking at the acceleration limit takes < 0.2 s at this speed
+    a = joints()
+    rospy.sleep(0.5)
+    b = joints()
+    return {"code": result.code, "message": result.message, "waist": a[0],
+            "drift": max(abs(x - y) for x, y in zip(a, b, strict=True))}
+
+
+def grasp(arm, gripper):
+    from rascal_msgs.srv import GetGroundTruth
+    rospy.wait_for_service("/sim/ground_truth", 10.0)
+    sherds = rospy.ServiceProxy("/sim/ground_truth", GetGroundTruth)().sherds
+    # The sherd nearest the middle of the pickup area; fingers across its minor axis.
+    s = min(sherds, key=lambda s: math.hypot(s.pose.position.x - 0.16, s.pose.position.y - 0.25))
+    q = s.pose.orientation
+    yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+    x, y = s.pose.position.x, s.pose.position.y
+    top = s.pose.position.z + s.thickness
+    gripper.open()
+    arm.move_to(Arm.top_down(x, y, top + 0.06, yaw))
+    arm.move_to(Arm.top_down(x, y, max(0.013, top - 0.003), yaw), motion="linear", speed_scale=0.5)
+    held = gripper.close()
+    arm.move_to(Arm.top_down(x, y, top + 0.06, yaw), motion="linear")
+    empty_open = gripper.open()
+    arm.move_to(Arm.top_down(0.30, 0.10, 0.15))  # over the bare table
+    empty = gripper.close()
+    return {"held": held.holding, "held_width": held.width, "empty": empty.holding,
+            "empty_width": empty.width, "open_width": empty_open.width,
+            "sherd_width": s.width, "sherd": s.name}
+
+
+def main():
+    rospy.init_node("rascal_control_wiring_client", anonymous=True)
+    arm, gripper = Arm(wait=30.0), Gripper(wait=30.0)
+    scenario = sys.argv[1]
+    try:
+        if scenario == "grasp":
+            out = grasp(arm, gripper)
+        else:
+            run = {"pose_goal": pose_goal, "unreachable": unreachable, "cancel": cancel}[scenario]
+            out = run(arm)
+    except ControlError as e:
+        out = error_dict(e)
+    print(json.dumps(out), flush=True)
+
+
+if __name__ == "__main__":
+    main()
