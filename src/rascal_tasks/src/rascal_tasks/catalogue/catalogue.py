@@ -23,7 +23,7 @@ import psycopg2.errors
 import psycopg2.extras
 from psycopg2 import sql
 
-from . import migrate as _migrate
+from .migrate import status as _migration_status
 from .context_id import validate_context_id, validate_site_id
 from .errors import CatalogueError, FieldError, StatusError
 from .fields import (check_count, check_munsell, check_number, check_sha256, check_text,
@@ -89,7 +89,7 @@ class Catalogue:
 
     def check_schema(self):
         """Raise CatalogueError unless every shipped migration has been applied."""
-        pending = [r for r in _migrate.status(self._conn) if r[3] != 'applied']
+        pending = [r for r in _migration_status(self._conn) if r[3] != 'applied']
         if pending:
             raise CatalogueError('database schema is not up to date (%s); run `rascal db migrate`'
                                  % ', '.join('%04d_%s: %s' % (v, n, st)
