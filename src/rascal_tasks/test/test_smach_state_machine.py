@@ -416,3 +416,64 @@ def test_machine_and_touched_userdata_can_be_pickled(logs):
     clone = pickle.loads(pickle.dumps(sm))
     assert clone.userdata.x == [1, 2] and clone.userdata.y == 3
     assert clone.execute() == 'done'
+
+
+def test_star_import_gives_smachs_names_and_submodules():
+    namespace = {}
+    exec('from rascal_tasks.smach import *', namespace)
+    for name in ('StateMachine', 'Concurrence', 'UserData', 'cb_interface', 'state',
+                 'user_data', 'InvalidUserCodeError', 'set_shutdown_check'):
+        assert name in namespace, name
+    assert 'SmachError' not in namespace
+
+
+def test_cores_import_without_ros():
+    import subprocess
+
+    from conftest import PYTHON, subprocess_env
+    code = ('import sys; import rascal_tasks.smach, rascal_tasks.catalogue, rascal_tasks.cli; '
+            'bad = [m for m in sys.modules if m.split(".")[0] in ("rospy", "roslib", "genpy")]; '
+            'print(bad); sys.exit(1 if bad else 0)')
+    r = subprocess.run([PYTHON, '-c', code], capture_output=True, text=True,
+                       env=subprocess_env(), timeout=60)
+    assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_preempting_a_machine_preempts_its_running_concurrence(logs):
+    a, b = Waiter(service=True), Waiter(service=True)
+    cc = smach.Concurrence(outcomes=['ok', 'stopped'], default_outcome='ok',
+                           outcome_map={'stopped': {'A': 'preempted', 'B': 'preempted'}})
+    with cc:
+        smach.Concurrence.add('A', a)
+        smach.Concurrence.add('B', b)
+    sm = smach.StateMachine(outcomes=['ok', 'halted'])
+    with sm:
+        smach.StateMachine.add('CC', cc, transitions={'stopped': 'halted'})
+    threading.Thread(target=lambda: (a.started.wait(5), b.started.wait(5), sm.request_preempt()),
+                     daemon=True).start()
+    assert sm.execute() == 'halted'
+    assert a.saw_preempt and b.saw_preempt
+    assert not sm.preempt_requested()
+
+
+def test_iterator_nested_in_machine_reads_parent_keys(logs):
+    seen = []
+
+    class Use(smach.State):
+        def __init__(self):
+            smach.State.__init__(self, outcomes=['next'])
+
+        def execute(self, ud):
+            seen.append((ud.it_data, ud.factor))
+            return 'next'
+
+    it = smach.Iterator(outcomes=['all_done'], input_keys=['factor'], output_keys=[],
+                        it=[1, 2], exhausted_outcome='all_done')
+    with it:
+        smach.Iterator.set_contained_state('USE', Use(), loop_outcomes=['next'])
+    sm = smach.StateMachine(outcomes=['all_done'])
+    sm.userdata.factor = 3
+    with sm:
+        smach.StateMachine.add('IT', it)
+    assert sm.execute() == 'all_done'
+    assert seen == [(1, 3), (2, 3)]
