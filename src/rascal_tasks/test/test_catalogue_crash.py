@@ -141,3 +141,25 @@ time.sleep(120)
             proc.wait()
     assert cat.new_sherd('C')['seq'] == 1  # (the module's timeout catches a hang)
     cat.close()
+
+
+def test_lost_database_connection_is_one_line_and_reconnect_resumes(migrated_dsn):
+    import psycopg2
+
+    from rascal_tasks.catalogue import CatalogueError
+    cat = Catalogue.connect(migrated_dsn, rig='rig-a', config_hash='h')
+    cat.open_context('C', 'site')
+    s = cat.new_sherd('C')
+    cat.record_mass(s['sherd_id'], 30.0)
+    pid = cat.connection.get_backend_pid()
+    admin = psycopg2.connect(migrated_dsn)
+    admin.autocommit = True
+    with admin.cursor() as cur:
+        cur.execute('SELECT pg_terminate_backend(%s)', (pid,))  # as a server restart would
+    admin.close()
+    with pytest.raises(CatalogueError, match='connection lost while recording photographed'):
+        cat.record_photo(s['sherd_id'], 'C/1.png', 'a' * 64)
+    cat.reconnect()
+    assert [(r['seq'], r['status'], r['mass_g']) for r in cat.resume('C')] == \
+        [(1, 'weighed', 30.0)]
+    cat.close()

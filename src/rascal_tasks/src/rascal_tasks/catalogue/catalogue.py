@@ -13,9 +13,11 @@ run continues them instead of recording the same sherd twice.
 
 The connection, logger and clock are injected; nothing here imports ROS.
 """
+import contextlib
 import datetime
 import json
 import logging
+import threading
 import time
 
 import psycopg2
@@ -44,6 +46,10 @@ _SHERD_COLUMNS = (
     'config_hash, picked_at, weighed_at, photographed_at, done_at, lost_at, updated_at')
 
 
+def _first_line(exc):
+    return (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+
+
 def _find_id(context_id, seq):
     return '%s-%d' % (context_id, seq)
 
@@ -66,6 +72,9 @@ class Catalogue:
                                             allow_none=False)
         self._log = logger or logging.getLogger('rascal.catalogue')
         self._clock = clock
+        self._lock = threading.RLock()  # one transaction at a time on the shared connection
+        self._dsn = None
+        self._connect_timeout = 5.0
 
     @classmethod
     def connect(cls, dsn, rig, config_hash, connect_timeout=5.0, **kwargs):
@@ -77,8 +86,29 @@ class Catalogue:
             raise CatalogueError('database.dsn: cannot connect (%s); is PostgreSQL running and '
                                  'the DSN right?' % str(e).strip().splitlines()[0]) from None
         cat = cls(conn, rig, config_hash, **kwargs)
+        cat._dsn, cat._connect_timeout = dsn, connect_timeout
         cat.check_schema()
         return cat
+
+    def reconnect(self):
+        """Open a new connection with the DSN given to ``connect`` (after the database was
+        restarted). Nothing is retried: call ``resume`` to see what was saved."""
+        if self._dsn is None:
+            raise CatalogueError('reconnect: this catalogue was built on a connection, not a '
+                                 'DSN; use Catalogue.connect(dsn, ...)')
+        with self._lock:
+            try:
+                self._conn.close()
+            except psycopg2.Error:
+                pass
+            try:
+                self._conn = psycopg2.connect(
+                    self._dsn, connect_timeout=max(1, int(round(self._connect_timeout))),
+                    application_name='rascal')
+            except psycopg2.OperationalError as e:
+                raise CatalogueError('database.dsn: cannot connect (%s); is PostgreSQL running?'
+                                     % str(e).strip().splitlines()[0]) from None
+            self._conn.autocommit = False
 
     @property
     def connection(self):
@@ -99,8 +129,23 @@ class Catalogue:
     def _now(self):
         return datetime.datetime.fromtimestamp(self._clock(), tz=datetime.timezone.utc)
 
-    def _cursor(self):
-        return self._conn.cursor(cursor_factory=psycopg2.extras.RealDictCursor)
+    @contextlib.contextmanager
+    def _tx(self, what):
+        """One transaction: commit on success, roll back on any error. Database failures
+        become one-line CatalogueErrors (a UniqueViolation is left to new_sherd)."""
+        with self._lock:
+            try:
+                with self._conn, self._conn.cursor(
+                        cursor_factory=psycopg2.extras.RealDictCursor) as cur:
+                    yield cur
+            except psycopg2.errors.UniqueViolation:
+                raise
+            except (psycopg2.OperationalError, psycopg2.InterfaceError) as e:
+                raise CatalogueError(
+                    'database: connection lost while %s (%s); what was not committed is not '
+                    'saved: reconnect and resume' % (what, _first_line(e))) from e
+            except psycopg2.Error as e:
+                raise CatalogueError('database refused %s: %s' % (what, _first_line(e))) from e
 
     def _event(self, cur, kind, context_id=None, sherd_id=None, detail=None, at=None):
         cur.execute('INSERT INTO events (at, context_id, sherd_id, kind, rig, detail) '
@@ -115,7 +160,7 @@ class Catalogue:
         validate_context_id(context_id)
         validate_site_id(site_id)
         check_text('description', description, 500)
-        with self._conn, self._cursor() as cur:
+        with self._tx('opening the context') as cur:
             cur.execute('INSERT INTO sites (site_id) VALUES (%s) ON CONFLICT DO NOTHING',
                         (site_id,))
             cur.execute('INSERT INTO contexts (context_id, site_id, description) '
@@ -157,7 +202,7 @@ class Catalogue:
         for attempt in range(_SEQ_RETRIES):
             now = self._now()
             try:
-                with self._conn, self._cursor() as cur:
+                with self._tx('taking a sequence number') as cur:
                     cur.execute('SELECT 1 FROM contexts WHERE context_id = %s FOR UPDATE',
                                 (context_id,))
                     if cur.fetchone() is None:
@@ -207,7 +252,7 @@ class Catalogue:
                         'AND status = ANY(%s::sherd_status[]) '
                         'RETURNING context_id, seq, status::text AS status').format(
             sql.SQL(', ').join(sets))
-        with self._conn, self._cursor() as cur:
+        with self._tx('recording ' + kind) as cur:
             cur.execute(query, values + [sherd_id, list(allowed_from)])
             row = cur.fetchone()
             if row is None:
@@ -312,7 +357,7 @@ class Catalogue:
     def add_note(self, sherd_id, note):
         """Free text for the archaeologist (appended to the record's notes)."""
         check_text('note', note, 2000, allow_none=False)
-        with self._conn, self._cursor() as cur:
+        with self._tx('adding a note') as cur:
             cur.execute("UPDATE sherds SET notes = concat_ws(E'\\n', notes, %s), updated_at = %s "
                         'WHERE sherd_id = %s RETURNING context_id', (note, self._now(), sherd_id))
             row = cur.fetchone()
@@ -322,7 +367,7 @@ class Catalogue:
 
     # --- reading ---
     def get(self, sherd_id):
-        with self._conn, self._cursor() as cur:
+        with self._tx('reading a sherd') as cur:
             cur.execute('SELECT ' + _SHERD_COLUMNS + ' FROM sherds s JOIN contexts c '
                         'USING (context_id) WHERE sherd_id = %s', (sherd_id,))
             row = cur.fetchone()
@@ -339,7 +384,7 @@ class Catalogue:
         if statuses is not None:
             q += ' AND status::text = ANY(%s)'
             args.append(list(statuses))
-        with self._conn, self._cursor() as cur:
+        with self._tx('reading the sherds') as cur:
             cur.execute(q + ' ORDER BY seq', args)
             return [self._record(r) for r in cur.fetchall()]
 
@@ -353,7 +398,7 @@ class Catalogue:
         """Start again on a context after a stop or crash: returns this rig's unfinished
         sherds (oldest first) for the caller to continue, and logs a 'resumed' event."""
         rows = self.unfinished(context_id, self._rig)
-        with self._conn, self._cursor() as cur:
+        with self._tx('logging the resume') as cur:
             self._event(cur, 'resumed', context_id,
                         detail={'unfinished': [r['seq'] for r in rows]})
         if rows:
@@ -364,7 +409,7 @@ class Catalogue:
 
     def events(self, context_id):
         validate_context_id(context_id)
-        with self._conn, self._cursor() as cur:
+        with self._tx('reading the events') as cur:
             cur.execute('SELECT event_id, at, context_id, sherd_id, kind, rig, detail '
                         'FROM events WHERE context_id = %s ORDER BY event_id', (context_id,))
             return [dict(r) for r in cur.fetchall()]
