@@ -4,6 +4,7 @@ import os
 import sys
 
 import pytest
+from catalogue_helpers import FakeClock
 
 _SRC = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'src')
 try:
@@ -36,29 +37,6 @@ def logs():
 
 
 # --- catalogue fixtures (use the root conftest's `pg_dsn`: a fresh database per test) ---
-PYTHON = '/usr/bin/python3'
-
-
-def subprocess_env():
-    """Environment for a child /usr/bin/python3 that must import rascal_tasks."""
-    import rascal_tasks
-    src = os.path.dirname(os.path.dirname(os.path.abspath(rascal_tasks.__file__)))
-    env = dict(os.environ)
-    env['PYTHONPATH'] = os.pathsep.join(p for p in (src, env.get('PYTHONPATH')) if p)
-    env['PYTHONUNBUFFERED'] = '1'
-    return env
-
-
-class FakeClock:
-    """Deterministic wall clock for record timestamps: +1.25 s per reading."""
-
-    def __init__(self, start=1_790_000_000.0):
-        self.t = start
-
-    def __call__(self):
-        self.t += 1.25
-        return self.t
-
 
 @pytest.fixture
 def migrated_dsn(pg_dsn):

@@ -4,7 +4,7 @@ import os
 import subprocess
 
 import pytest
-from conftest import PYTHON, FakeClock, subprocess_env
+from catalogue_helpers import PYTHON, FakeClock, subprocess_env
 
 from rascal_tasks.catalogue import COLUMNS, Catalogue, ImageArchive, parse_csv
 

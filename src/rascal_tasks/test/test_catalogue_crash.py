@@ -4,7 +4,7 @@ import signal
 import subprocess
 
 import pytest
-from conftest import PYTHON, subprocess_env
+from catalogue_helpers import PYTHON, subprocess_env
 
 from rascal_tasks.catalogue import Catalogue, ImageArchive
 

@@ -430,7 +430,7 @@ def test_star_import_gives_smachs_names_and_submodules():
 def test_cores_import_without_ros():
     import subprocess
 
-    from conftest import PYTHON, subprocess_env
+    from catalogue_helpers import PYTHON, subprocess_env
     code = ('import sys; import rascal_tasks.smach, rascal_tasks.catalogue, rascal_tasks.cli; '
             'bad = [m for m in sys.modules if m.split(".")[0] in ("rospy", "roslib", "genpy")]; '
             'print(bad); sys.exit(1 if bad else 0)')
