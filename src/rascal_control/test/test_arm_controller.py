@@ -139,21 +139,25 @@ class TestAgainstTheSimulator:
 
     def test_pose_goal_arrives_within_2_mm(self, rig):
         out = self.client(rig, "pose_goal")
+        print(out)
         assert "error" not in out, out
         assert out["joint_error"] < 0.002 and out["linear_error"] < 0.002, out
 
     def test_unreachable_goal_fails_fast_and_does_not_move(self, rig):
         out = self.client(rig, "unreachable")
+        print(out)
         assert out["error"] == "Unreachable" and out["code"] == 1, out
         assert out["seconds"] < 1.0 and out["moved"] < 1e-3, out
 
     def test_cancelled_move_stops(self, rig):
         out = self.client(rig, "cancel")
+        print(out)
         assert out["code"] == 4, out
         assert 0.0 < out["waist"] < 2.4 and out["drift"] < 1e-3, out
 
     def test_gripper_reports_held_on_a_sherd_and_not_on_nothing(self, rig):
         out = self.client(rig, "grasp")
+        print(out)
         assert "error" not in out, out
         assert out["held"] and not out["empty"], out
         assert out["held_width"] > 0.032 and out["empty_width"] < 0.032, out

@@ -550,7 +550,7 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
     bool stalled = false;
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
-      if (!finger_history_.empty() && elapsed > stroke + kStallWindow && elapsed > 1.5 * kStallWindow) {
+      if (!finger_history_.empty() && elapsed > 1.5 * kStallWindow) {
         const double t_now = finger_history_.back().first;
         double lo = finger_history_.back().second, hi = lo;
         bool covered = false;
