@@ -33,8 +33,8 @@ class SensorEffects {
  private:
   std::mt19937 rng_;
   std::vector<float> gauss_;  ///< a table of N(0, 1) samples, read from a random offset
-  float gauss();
-  size_t cursor_ = 0;
+  std::vector<int16_t> noise_;  ///< gauss_ scaled by the colour noise sigma, in counts
+  float noise_sigma_ = -1.0f;
 };
 
 }  // namespace rascal_sim

@@ -66,6 +66,8 @@ class Simulator {
   bool wristFrameDue() const;
   /// Renders the wrist camera at the present time and schedules the next frame.
   WristFrame renderWristFrame();
+  /// Drops the due frame unrendered (nobody is listening) and schedules the next one.
+  void skipWristFrame();
   Eigen::Isometry3d wristCameraPose() const;
   const CameraModel& wristModel() const { return options_.wrist_model; }
 

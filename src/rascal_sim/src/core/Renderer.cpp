@@ -30,29 +30,47 @@ void rasterTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Ei
   if (x0 > x1 || y0 > y1) return;
   const double inv_area = 1.0 / area;
   const double iza = 1.0 / a.z(), izb = 1.0 / b.z(), izc = 1.0 / c.z();
-  // barycentric weights as affine functions of (x, y)
+  // barycentric weights w0 (of a), w1 (of b), w2 = 1 - w0 - w1 as affine functions of (x, y)
   const double w0x = (vb - vc) * inv_area, w0y = (uc - ub) * inv_area;
   const double w1x = (vc - va) * inv_area, w1y = (ua - uc) * inv_area;
-  const double w0c = ((ub - x0) * (vc - y0) - (vb - y0) * (uc - x0)) * inv_area;
-  const double w1c = ((uc - x0) * (va - y0) - (vc - y0) * (ua - x0)) * inv_area;
+  const double w0o = (ub * vc - vb * uc) * inv_area;  // value at (0, 0)
+  const double w1o = (uc * va - vc * ua) * inv_area;
+  const double izx = w0x * iza + w1x * izb - (w0x + w1x) * izc;
   const cv::Vec3f col(colour.x(), colour.y(), colour.z());
-  const double eps = -1e-9;
+  const uint16_t lid = static_cast<uint16_t>(id);
+  const double eps = 1e-9;
   for (int y = y0; y <= y1; ++y) {
-    double w0 = w0c + w0y * (y - y0);
-    double w1 = w1c + w1y * (y - y0);
+    // span of x where all three weights are >= 0 on this row
+    const double a0 = w0o + w0y * y, a1 = w1o + w1y * y;
+    const double a2 = 1.0 - a0 - a1, b2 = -(w0x + w1x);
+    double lo = x0, hi = x1;
+    bool empty = false;
+    auto limit = [&](double a, double b) {
+      if (std::abs(b) < 1e-15) {
+        if (a < -eps) empty = true;
+      } else if (b > 0) {
+        lo = std::max(lo, (-a - eps) / b);
+      } else {
+        hi = std::min(hi, (-a - eps) / b);
+      }
+    };
+    limit(a0, w0x);
+    limit(a1, w1x);
+    limit(a2, b2);
+    if (empty || lo > hi) continue;
+    const int xs = std::max(x0, static_cast<int>(std::ceil(lo))), xe = std::min(x1, static_cast<int>(std::floor(hi)));
     float* drow = t.depth->ptr<float>(y);
     cv::Vec3f* crow = t.radiance->ptr<cv::Vec3f>(y);
     uint16_t* lrow = t.label->ptr<uint16_t>(y);
-    for (int x = x0; x <= x1; ++x, w0 += w0x, w1 += w1x) {
-      const double w2 = 1.0 - w0 - w1;
-      if (w0 < eps || w1 < eps || w2 < eps) continue;
-      const double iz = w0 * iza + w1 * izb + w2 * izc;
+    const double izr = a0 * iza + a1 * izb + a2 * izc;
+    for (int x = xs; x <= xe; ++x) {
+      const double iz = izr + izx * x;
       if (iz <= 0) continue;
       const float z = static_cast<float>(1.0 / iz);
       if (drow[x] != 0.0f && z >= drow[x]) continue;
       drow[x] = z;
       crow[x] = col;
-      lrow[x] = static_cast<uint16_t>(id);
+      lrow[x] = lid;
     }
   }
 }

@@ -9,33 +9,20 @@
 namespace rascal_sim {
 
 namespace {
-constexpr size_t kGaussTable = 1 << 20;
+constexpr size_t kGaussTable = 1 << 21;
 constexpr double kDepthCx = 319.0;  // [px] D435 depth at 640 x 480 (facts §4.3)
 constexpr double kShadowPeriod = 60.0;  // [s] the shadow's path repeats
 
 uint8_t encodeSrgb(float linear) {
-  static const std::vector<uint8_t> lut = [] {
-    std::vector<uint8_t> l(4097);
-    for (int i = 0; i <= 4096; ++i) {
-      const double c = i / 4096.0;
-      const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
-      l[i] = static_cast<uint8_t>(std::lround(std::min(1.0, s) * 255));
-    }
-    return l;
-  }();
-  const int i = static_cast<int>(std::min(1.0f, std::max(0.0f, linear)) * 4096.0f + 0.5f);
-  return lut[i];
+  const double c = std::min(1.0f, std::max(0.0f, linear));
+  const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+  return static_cast<uint8_t>(std::lround(std::min(1.0, s) * 255));
 }
 }  // namespace
 
 SensorEffects::SensorEffects(unsigned seed) : rng_(seed), gauss_(kGaussTable) {
   std::normal_distribution<float> n(0.0f, 1.0f);
   for (auto& g : gauss_) g = n(rng_);
-}
-
-float SensorEffects::gauss() {
-  cursor_ = (cursor_ + 1) & (kGaussTable - 1);
-  return gauss_[cursor_];
 }
 
 Eigen::Vector3d SensorEffects::temperatureGains(double kelvin) {
@@ -63,28 +50,45 @@ cv::Mat SensorEffects::colourImage(const cv::Mat& radiance, const cv::Mat& depth
   const float g0 = static_cast<float>(gain.x()), g1 = static_cast<float>(gain.y()), g2 = static_cast<float>(gain.z());
   const bool shadow = lighting.shadow_strength > 0.0;
   const Eigen::Vector2d centre = lighting.shadow_start + lighting.shadow_velocity * std::fmod(t, kShadowPeriod);
-  const double r_out = lighting.shadow_radius, r_in = 0.6 * lighting.shadow_radius;
+  const float r_out = static_cast<float>(lighting.shadow_radius), r_in = 0.6f * r_out;
+  const float strength = static_cast<float>(lighting.shadow_strength);
   const Eigen::Matrix3d R = world_T_camera.linear();
   const Eigen::Vector3d p0 = world_T_camera.translation();
+  // world ray of pixel (x, y) = row + x * dx (per unit depth)
+  const Eigen::Vector3d dx = R.col(0) / cam.fx;
+  const float dxx = static_cast<float>(dx.x()), dxy = static_cast<float>(dx.y());
+  const float cx0 = static_cast<float>(p0.x() - centre.x()), cy0 = static_cast<float>(p0.y() - centre.y());
+  const float r_out2 = r_out * r_out;
+  static const std::vector<uint8_t> lut = [] {
+    std::vector<uint8_t> l(4097);
+    for (int i = 0; i <= 4096; ++i) l[i] = encodeSrgb(i / 4096.0f);
+    return l;
+  }();
+  auto enc = [](float v) {
+    const int i = static_cast<int>(v * 4096.0f + 0.5f);
+    return lut[i < 0 ? 0 : (i > 4096 ? 4096 : i)];
+  };
   cv::Mat img(cam.height, cam.width, CV_8UC3);
   for (int y = 0; y < cam.height; ++y) {
     const cv::Vec3f* rrow = radiance.ptr<cv::Vec3f>(y);
     const float* drow = depth.ptr<float>(y);
     cv::Vec3b* out = img.ptr<cv::Vec3b>(y);
-    const double ny = (y - cam.cy) / cam.fy;
+    const Eigen::Vector3d row = R * Eigen::Vector3d(-cam.cx / cam.fx, (y - cam.cy) / cam.fy, 1.0);
+    const float rx = static_cast<float>(row.x()), ry = static_cast<float>(row.y());
     for (int x = 0; x < cam.width; ++x) {
       float f = 1.0f;
-      if (shadow && drow[x] > 0) {
-        const double z = drow[x];
-        const Eigen::Vector3d pw = R * Eigen::Vector3d((x - cam.cx) / cam.fx * z, ny * z, z) + p0;
-        const double d = (pw.head<2>() - centre).norm();
-        if (d < r_out) {
-          const double s = d <= r_in ? 1.0 : (r_out - d) / (r_out - r_in);
-          f = static_cast<float>(1.0 - lighting.shadow_strength * s * s * (3 - 2 * s));
+      const float z = drow[x];
+      if (shadow && z > 0.0f) {
+        const float wx = cx0 + z * (rx + x * dxx), wy = cy0 + z * (ry + x * dxy);
+        const float d2 = wx * wx + wy * wy;
+        if (d2 < r_out2) {
+          const float d = std::sqrt(d2);
+          const float s = d <= r_in ? 1.0f : (r_out - d) / (r_out - r_in);
+          f = 1.0f - strength * s * s * (3.0f - 2.0f * s);
         }
       }
       const cv::Vec3f& c = rrow[x];
-      out[x] = cv::Vec3b(encodeSrgb(c[0] * g0 * f), encodeSrgb(c[1] * g1 * f), encodeSrgb(c[2] * g2 * f));
+      out[x] = cv::Vec3b(enc(c[0] * g0 * f), enc(c[1] * g1 * f), enc(c[2] * g2 * f));
     }
   }
   if (blur_px >= 1.5) {
@@ -93,12 +97,20 @@ cv::Mat SensorEffects::colourImage(const cv::Mat& radiance, const cv::Mat& depth
   }
   const float sigma = static_cast<float>(lighting.colour_noise);
   if (sigma > 0) {
-    cursor_ = rng_() & (kGaussTable - 1);
+    if (noise_sigma_ != sigma) {
+      noise_sigma_ = sigma;
+      noise_.resize(gauss_.size());
+      for (size_t i = 0; i < gauss_.size(); ++i) {
+        noise_[i] = static_cast<int16_t>(std::lround(std::max(-127.0f, std::min(127.0f, sigma * gauss_[i]))));
+      }
+    }
     uint8_t* p = img.ptr<uint8_t>(0);
     const size_t n = img.total() * 3;
-    for (size_t i = 0; i < n; ++i) {
-      const float v = p[i] + sigma * gauss();
-      p[i] = static_cast<uint8_t>(std::min(255.0f, std::max(0.0f, v + 0.5f)));
+    // a contiguous window of the table at a random offset (vectorises)
+    const int16_t* nz = noise_.data() + (n < kGaussTable ? rng_() % (kGaussTable - n) : 0);
+    for (size_t i = 0; i < std::min(n, kGaussTable); ++i) {
+      const int v = p[i] + nz[i];
+      p[i] = static_cast<uint8_t>(v < 0 ? 0 : (v > 255 ? 255 : v));
     }
   }
   return img;
@@ -106,26 +118,29 @@ cv::Mat SensorEffects::colourImage(const cv::Mat& radiance, const cv::Mat& depth
 
 cv::Mat SensorEffects::depthImage(const cv::Mat& depth, const CameraModel& cam, bool left_band) {
   cv::Mat out(cam.height, cam.width, CV_16UC1);
-  cursor_ = rng_() & (kGaussTable - 1);
+  const size_t total = static_cast<size_t>(cam.width) * cam.height;
+  const float* g = gauss_.data() + (total < kGaussTable ? rng_() % (kGaussTable - total) : 0);
+  // left invalid band: seen by the left imager only, f*B/Z depth pixels wide;
+  // column x is inside it when z * band[x] < f*B
+  std::vector<float> band(cam.width);
+  for (int x = 0; x < cam.width; ++x) {
+    band[x] = left_band ? static_cast<float>(kDepthFocal * (x - cam.cx) / cam.fx + kDepthCx) : 1e9f;
+  }
+  const float fb = static_cast<float>(kDepthFocal * kBaseline);
+  const float noise_k = static_cast<float>(kSubpixelSigma / (kDepthFocal * kBaseline));
+  const float zmin = static_cast<float>(kMinDepth);
   for (int y = 0; y < cam.height; ++y) {
     const float* d = depth.ptr<float>(y);
     uint16_t* o = out.ptr<uint16_t>(y);
     for (int x = 0; x < cam.width; ++x) {
-      const double z = d[x];
-      if (z < kMinDepth) {
+      const float z = d[x];
+      if (z < zmin || z * band[x] < fb) {
         o[x] = 0;
         continue;
       }
-      if (left_band) {
-        // left invalid band: seen by the left imager only, f*B/Z depth pixels wide
-        const double edge = (kDepthFocal * kBaseline / z - kDepthCx) / kDepthFocal;
-        if ((x - cam.cx) / cam.fx < edge) {
-          o[x] = 0;
-          continue;
-        }
-      }
-      const double zn = z + depthSigma(z) * gauss();
-      o[x] = static_cast<uint16_t>(std::min(65535.0, std::max(0.0, std::round(zn * 1000.0))));
+      const float zn = z + z * z * noise_k * g[static_cast<size_t>(y) * cam.width + x];
+      const float mm = zn * 1000.0f + 0.5f;
+      o[x] = static_cast<uint16_t>(mm < 0.0f ? 0.0f : (mm > 65535.0f ? 65535.0f : mm));
     }
   }
   return out;

@@ -138,9 +138,13 @@ WristFrame Simulator::renderWristFrame() {
   f.rgb = effects_.colourImage(scratch_.radiance, scratch_.depth, cam, f.world_T_camera, scenario_.lighting,
                                f.stamp, blur);
   f.depth_mm = effects_.depthImage(scratch_.depth, cam);
+  skipWristFrame();
+  return f;
+}
+
+void Simulator::skipWristFrame() {
   const double period = 1.0 / options_.wrist_rate;
   while (next_wrist_frame_ <= time() + 1e-9) next_wrist_frame_ += period;
-  return f;
 }
 
 cv::Mat Simulator::renderArchival() {

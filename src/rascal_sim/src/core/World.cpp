@@ -111,6 +111,9 @@ struct World::Impl {
       const Sherd& s = *sherds[t1->index];
       if (t1->index == held || time < s.ignore_until) return;
     }
+    if (t1->kind == GeomTag::kSherd && (arm2 || t2->kind == GeomTag::kPlatform) && !dBodyIsEnabled(b1)) {
+      dBodyEnable(b1);  // the arm or the pan wakes a sleeping sherd
+    }
     dContact c[4];
     const int n = dCollide(o1, o2, 4, &c[0].geom, sizeof(dContact));
     if (n == 0) return;
@@ -209,6 +212,7 @@ struct World::Impl {
     dMassSetBoxTotal(&m, kPlatformMass, l.scale.size.x(), l.scale.size.y(), kPlatformThickness);
     dBodySetMass(platform, &m);
     dBodySetPosition(platform, l.scale.position.x(), l.scale.position.y(), top - kPlatformThickness / 2);
+    dBodySetAutoDisableFlag(platform, 0);
     dGeomID pg = dCreateBox(space, l.scale.size.x(), l.scale.size.y(), kPlatformThickness);
     dGeomSetBody(pg, platform);
     dGeomSetData(pg, tag(GeomTag::kPlatform, 0));
@@ -230,6 +234,7 @@ struct World::Impl {
       if (!link_bodies[b.link]) {
         link_bodies[b.link] = dBodyCreate(world);
         dBodySetKinematic(link_bodies[b.link]);
+        dBodySetAutoDisableFlag(link_bodies[b.link], 0);
       }
       dGeomID g = dCreateBox(space, b.size.x(), b.size.y(), b.size.z());
       dGeomSetBody(g, link_bodies[b.link]);
@@ -275,10 +280,15 @@ World::World(const WorldLayout& layout) : impl_(new Impl), layout_(layout) {
   dWorldSetGravity(w.world, 0, 0, -kGravity);
   dWorldSetERP(w.world, 0.2);
   dWorldSetCFM(w.world, 1e-7);
-  dWorldSetQuickStepNumIterations(w.world, 40);
+  dWorldSetQuickStepNumIterations(w.world, 20);
   dWorldSetContactMaxCorrectingVel(w.world, 0.2);
   dWorldSetContactSurfaceLayer(w.world, 0.0002);
-  dWorldSetAutoDisableFlag(w.world, 0);
+  // sherds at rest sleep until something touches them (the pan and the arm never sleep)
+  dWorldSetAutoDisableFlag(w.world, 1);
+  dWorldSetAutoDisableLinearThreshold(w.world, 0.002);
+  dWorldSetAutoDisableAngularThreshold(w.world, 0.02);
+  dWorldSetAutoDisableSteps(w.world, 50);
+  dWorldSetAutoDisableTime(w.world, 0);
   w.space = dHashSpaceCreate(nullptr);
   w.contact_group = dJointGroupCreate(0);
   w.buildFixtures(layout);
@@ -379,6 +389,8 @@ void World::hold(int sherd) {
   Impl& w = *impl_;
   if (w.held == sherd || sherd < 0 || sherd >= static_cast<int>(w.sherds.size())) return;
   release();
+  dBodyEnable(w.sherds[sherd]->body);
+  dBodySetAutoDisableFlag(w.sherds[sherd]->body, 0);  // follows the gripper even when it stops
   w.hold_joint = dJointCreateFixed(w.world, nullptr);
   dJointAttach(w.hold_joint, w.sherds[sherd]->body, w.link_bodies[kGripperLink]);
   dJointSetFixed(w.hold_joint);
@@ -388,6 +400,10 @@ void World::hold(int sherd) {
 void World::release() {
   Impl& w = *impl_;
   if (w.hold_joint) dJointDestroy(w.hold_joint);
+  if (w.held >= 0 && w.held < static_cast<int>(w.sherds.size())) {
+    dBodySetAutoDisableFlag(w.sherds[w.held]->body, 1);
+    dBodyEnable(w.sherds[w.held]->body);
+  }
   w.hold_joint = nullptr;
   w.held = -1;
 }
