@@ -35,9 +35,16 @@ def full_sherd(cat, archive, context='TR1-1023'):
                       colour_lab=(62.5, 21.25, 30.125), chart_delta_e00=1.7, px_per_cm=21.3,
                       t_photo_s=8.0)
     cat.add_note(s['sherd_id'], 'rim, burnt edge')
+    side = os.path.join(archive.root, context, '%d.json' % s['seq'])
+    with open(side) as f:
+        assert json.load(f)['status'] == 'photographed'
     cat.record_done(s['sherd_id'], t_discard_s=5.5,
                     timings={'locomotion': 21.5, 'grasping': 9.25, 'data_collection': 4.5,
-                             'perception': 1.125})
+                             'perception': 1.125}, archive=archive)
+    with open(side) as f:
+        final = json.load(f)
+    assert final['status'] == 'done' and final['mass_g'] == 25.3
+    assert final['image_sha256'] == cat.get(s['sherd_id'])['image_sha256']
     return s
 
 

@@ -65,12 +65,18 @@ class ImageArchive:
         directory = os.path.dirname(final)
         os.makedirs(directory, exist_ok=True)
         sha = self._write_atomic(final, self._chunks(image), check_png=True)
-        side = dict(record or {})
-        side.update({'image_path': rel, 'image_sha256': sha,
-                     'archived_at': datetime.datetime.now(datetime.timezone.utc)})
-        blob = json.dumps(side, default=_json_default, sort_keys=True, indent=1).encode() + b'\n'
-        self._write_atomic(final[:-4] + '.json', iter([blob]))
+        self.write_sidecar(context_id, seq, dict(record or {}, image_path=rel, image_sha256=sha))
         return rel, sha
+
+    def write_sidecar(self, context_id, seq, record):
+        """(Re)write ``<context>/<seq>.json`` atomically with ``record`` (the sherd's row)."""
+        rel = self.relpath(context_id, seq)
+        final = self.path(rel)[:-4] + '.json'
+        os.makedirs(os.path.dirname(final), exist_ok=True)
+        side = dict(record, written_at=datetime.datetime.now(datetime.timezone.utc))
+        blob = json.dumps(side, default=_json_default, sort_keys=True, indent=1).encode() + b'\n'
+        self._write_atomic(final, iter([blob]))
+        return final
 
     def verify(self, relpath, sha256):
         """True if the archived file exists and has this SHA-256."""

@@ -318,19 +318,24 @@ class Catalogue:
         if rec['status'] not in ('weighed', 'photographed'):
             raise StatusError("sherd %s is '%s': cannot record 'photographed' (only after "
                               'weighed, photographed)' % (rec['find_id'], rec['status']))
-        sidecar = dict(rec, **{k: v for k, v in photo.items() if k != 'colour_lab'})
+        sidecar = dict(rec, status='photographed',
+                       **{k: v for k, v in photo.items() if k != 'colour_lab'})
         if photo.get('colour_lab') is not None:
             lab = photo['colour_lab']
             sidecar.update(colour_l=lab[0], colour_a=lab[1], colour_b=lab[2])
         rel, sha = archive.store(rec['context_id'], rec['seq'], image, sidecar)
         return self.record_photo(sherd_id, rel, sha, **photo)
 
-    def record_done(self, sherd_id, t_discard_s=None, timings=None):
+    def record_done(self, sherd_id, t_discard_s=None, timings=None, archive=None):
         """The sherd is in the discard box; photographed -> done (final). ``timings`` is
-        ``{phase: seconds}`` for the phases in ``fields.PHASES`` (the paper's breakdown)."""
+        ``{phase: seconds}`` for the phases in ``fields.PHASES`` (the paper's breakdown).
+        With ``archive``, the image's JSON sidecar is rewritten with the final record."""
         f = {'t_discard_s': check_number('t_discard_s', t_discard_s, 0.0, 1e6, 's')}
         f.update(check_timings('timings', timings))
-        return self._advance(sherd_id, 'done', ('photographed',), f, 'done')
+        result = self._advance(sherd_id, 'done', ('photographed',), f, 'done')
+        if archive is not None:
+            archive.write_sidecar(result['context_id'], result['seq'], self.get(sherd_id))
+        return result
 
     def record_lost(self, sherd_id, reason, timings=None):
         """The sherd could not be found again; any unfinished state -> lost (final)."""
