@@ -213,7 +213,8 @@ def load_config(path: str, workspace: Optional[str] = None) -> Config:
         with open(path, encoding="utf-8") as f:
             data = yaml.safe_load(f)
     except FileNotFoundError:
-        raise ConfigError("%s: file not found; pass the path of config/rascal.yaml" % path) from None
+        raise ConfigError("%s: file not found; pass the path of config/rascal.yaml"
+                          % path) from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = " (line %d)" % (mark.line + 1) if mark else ""
@@ -297,6 +298,22 @@ def config_from_dict(data, source="config/rascal.yaml", workspace=".") -> Config
         sim.fail("scale_colours", "expected two [r, g, b] colours (the two-tone platform)", tones)
     for i, tone in enumerate(tones):
         _Reader(source, {i: tone}, sim.key("scale_colours")).colour(i)
+    sim.number("physics_step", 0.0002, 0.002, "seconds")
+    sim.number("clock_period", 0.0002, 0.1, "seconds")
+    sim.number("joint_state_period", 0.001, 0.01, "seconds (>= 100 Hz)")
+    sim.raw("wrist_camera")
+    if not isinstance(sim.data["wrist_camera"], bool):
+        sim.fail("wrist_camera", "expected true or false", sim.data["wrist_camera"])
+    sim.number("wrist_rate", 1.0, 30.0, "Hz")
+    sim.raw("point_cloud")
+    if not isinstance(sim.data["point_cloud"], bool):
+        sim.fail("point_cloud", "expected true or false", sim.data["point_cloud"])
+    sim.vector("initial_joints", 6, -math.pi, math.pi, "6 joint angles in radians")
+    sim.number("initial_finger", 0.015, 0.037, "metres")
+    size = sim.vector("archival_size", 2, 100, 20000, "[width, height] in pixels")
+    if size[0] < 2000 or size[1] < 1500:
+        sim.fail("archival_size", "expected at least [2000, 1500] pixels", list(size))
+    sim.string("spool_dir")
     sim.done()
     top.done()
     return Config(source=source, workspace=workspace, data=data, stations=stations)
