@@ -3,6 +3,8 @@
     rascal db migrate                      apply the catalogue's SQL migrations
     rascal db status                       show the database and which migrations are applied
     rascal export --context ID --format csv|json [--output FILE]
+    rascal run --context ID                one batch on the rig (config from the parameter server)
+    rascal report --context ID             HTML page: thumbnails, measurements, time breakdown
 
 The database comes from ``--dsn``, else ``$RASCAL_DSN``, else ``database.dsn`` of the site
 config (``--config``, else ``$RASCAL_CONFIG``, else ``config/rascal.yaml`` of the workspace),
@@ -155,6 +157,58 @@ def cmd_export(args, out):
     return 0
 
 
+# --- run and report ---
+def cmd_run(args, out):
+    from rascal_tasks.run_batch import run
+    return run(args.context, dsn=args.dsn)
+
+
+def cmd_report(args, out):
+    from rascal_tasks.catalogue import export_records, validate_context_id
+    from rascal_tasks.catalogue.errors import FieldError
+    from rascal_tasks.report import write_report
+    try:
+        validate_context_id(args.context)
+    except FieldError as e:
+        raise UsageError(str(e)) from None
+    path = _config_path(args)
+    if path is None:
+        raise UsageError('no site config found; pass --config config/rascal.yaml')
+    cfg = load_site_config(path)
+    conn, _, _ = connect(args)
+    try:
+        context, records = export_records(conn, args.context)
+    finally:
+        conn.close()
+    if not records:
+        raise UsageError("context '%s': no sherds recorded (check the context id)"
+                         % args.context)
+    done = [r for r in records if r['status'] == 'done']
+    totals = [sum(r.get('t_%s_s' % k) or 0.0 for k in ('locomotion', 'grasping',
+                                                         'data_collection', 'perception'))
+              for r in done]
+    summary = {'sherds': len(records), 'done': len(done),
+               'lost': sum(r['status'] == 'lost' for r in records),
+               'drops': sum(r.get('drops') or 0 for r in records),
+               'mean time per recorded sherd': '%.1f s' % (sum(totals) / len(totals))
+               if totals else '–'}
+    report = write_report(args.context, records, cfg.resolve(cfg['archive']['root']), summary)
+    print('report: %s' % report, file=out)
+    return 0
+
+
+def _add_run(sub):
+    run = sub.add_parser('run', help='record one bag: survey, pick, weigh, photograph, discard')
+    run.add_argument('--context', required=True, help='context id of the bag, e.g. TR1-1023')
+    run.set_defaults(func=cmd_run)
+
+
+def _add_report(sub):
+    rep = sub.add_parser('report', help="write an HTML report of a context's sherds")
+    rep.add_argument('--context', required=True, help='context id, e.g. TR1-1023')
+    rep.set_defaults(func=cmd_report)
+
+
 class _PrintLogger:
     def __init__(self, out):
         self.out = out
@@ -192,6 +246,8 @@ def build_parser():
     sub.required = True
     _add_db(sub)
     _add_export(sub)
+    _add_run(sub)
+    _add_report(sub)
     return p
 
 

@@ -8,6 +8,10 @@ import math
 import threading
 
 import rospy
+from rascal_control import Arm as ControlArm
+from rascal_control import Gripper as ControlGripper
+from rascal_control.results import ControlError
+from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from rascal_msgs.msg import ScaleReading as ScaleReadingMsg
@@ -15,6 +19,11 @@ from rascal_msgs.srv import CalibrateBackground, CaptureArchival, Detect
 from rascal_tasks import rig
 
 SERVICE_WAIT = 10.0  # s (wall clock): how long a node may take to come up
+# Fingers closed on nothing stop at 30 mm (facts §1.4); a sherd keeps them at least a few mm
+# wider. Below this the gripper is taken to be empty.
+EMPTY_OPENING = 0.030 + 0.003
+FULLY_OPEN = 0.074 - 0.004
+CODE_NAMES = {1: "UNREACHABLE", 2: "COLLISION", 3: "TIMEOUT", 4: "PREEMPTED", 5: "INVALID_GOAL"}
 
 
 def _yaw(q) -> float:
@@ -38,6 +47,86 @@ def _proxy(name, srv_type):
         raise rig.RigError(name, "MISSING", "service %s is not offered; is its node running?"
                            % name) from None
     return rospy.ServiceProxy(name, srv_type)
+
+
+def _rig_error(device: str, e: ControlError) -> rig.RigError:
+    return rig.RigError(device, CODE_NAMES.get(e.code, "FAILED"), e.message)
+
+
+class RosArm(rig.Arm):
+    """rascal_control.Arm with the gripper pointing down."""
+
+    def __init__(self, speed_scale: float = 1.0):
+        try:
+            self._arm = ControlArm(wait=SERVICE_WAIT)
+        except ControlError as e:
+            raise _rig_error("/rascal/arm/move", e) from None
+        self.speed_scale = speed_scale
+
+    def move_down(self, x, y, z, yaw, linear=False):
+        try:
+            res = self._arm.move_to(ControlArm.top_down(x, y, z, yaw),
+                                    motion="linear" if linear else "joint",
+                                    speed_scale=self.speed_scale)
+        except ControlError as e:
+            raise _rig_error("arm", e) from None
+        return res.duration
+
+    def go(self, named):
+        try:
+            return self._arm.go(named, speed_scale=self.speed_scale).duration
+        except ControlError as e:
+            raise _rig_error("arm", e) from None
+
+    def stop(self):
+        self._arm.stop()
+
+
+class RosGripper(rig.Gripper):
+    """rascal_control.Gripper, plus the finger gap from /joint_states to notice a drop."""
+
+    def __init__(self):
+        try:
+            self._gripper = ControlGripper(wait=SERVICE_WAIT)
+        except ControlError as e:
+            raise _rig_error("/rascal/gripper", e) from None
+        self._opening = None
+        self._closed = None  # the last command was a close (None: none sent yet, after a restart)
+        self._sub = rospy.Subscriber("/joint_states", JointState, self._on_joints, queue_size=2)
+
+    def _on_joints(self, msg):
+        if "left_finger" in msg.name:
+            self._opening = 2.0 * msg.position[msg.name.index("left_finger")]
+
+    def _run(self, fn, *args):
+        try:
+            return fn(*args)
+        except ControlError as e:
+            raise _rig_error("gripper", e) from None
+
+    def open(self, width=None):
+        self._closed = False
+        return self._run(self._gripper.open, width).duration
+
+    def close(self):
+        self._closed = True
+        res = self._run(self._gripper.close)
+        return rig.GraspResult(bool(res.holding), res.width)
+
+    def holding(self):
+        if self._closed is False:
+            return False
+        deadline = rospy.get_time() + 1.0
+        while self._opening is None and rospy.get_time() < deadline:
+            rospy.sleep(0.01)
+        if self._opening is None:
+            return False
+        if self._closed is None:  # after a restart: fingers neither open nor shut on nothing
+            return EMPTY_OPENING < self._opening < FULLY_OPEN
+        return self._opening > EMPTY_OPENING
+
+    def width(self):
+        return self._opening if self._opening is not None else 0.0
 
 
 class RosPerception(rig.Perception):
