@@ -12,9 +12,9 @@ namespace {
 
 // The station fixtures of config/rascal.yaml.
 void addStations(CollisionChecker& checker) {
-  checker.addFixture({"camera stand", KDL::Vector(0.50, -0.30, 0.30), KDL::Vector(0.04, 0.04, 0.60), false});
+  checker.addFixture({"camera stand", KDL::Vector(0.50, -0.30, 0.30), KDL::Vector(0.04, 0.04, 0.60), false, {}});
   checker.addOpenBox("discard box", 0.02, -0.31, 0.14, 0.13, 0.04, 0.004);
-  checker.addFixture({"scale", KDL::Vector(0.30, 0.0, 0.0125), KDL::Vector(0.13, 0.13, 0.025), true});
+  checker.addFixture({"scale", KDL::Vector(0.30, 0.0, 0.0125), KDL::Vector(0.13, 0.13, 0.025), true, {}});
 }
 
 }  // namespace
@@ -75,6 +75,22 @@ TEST(CollisionChecker, MoveThroughTheCameraStandIsRefused) {
   TrajectoryPlanner free_planner(testModel(), ik, &table_only);
   EXPECT_TRUE(free_planner.planLinear(start.joints, to, 1.0).ok());
   EXPECT_TRUE(free_planner.planJoint(start.joints, goal.joints, 1.0).ok());
+}
+
+TEST(CollisionChecker, TheArmKeepsOffItsOwnBase) {
+  CollisionChecker checker(testModel());
+  ASSERT_EQ(checker.fixtures().size(), 1u);
+  EXPECT_EQ(checker.fixtures()[0].name, "arm base");
+  IkSolver ik(testModel());
+  // Gripper pointing down just in front of the base, below its top (z = 0.072).
+  const IkResult r = ik.solve(IkSolver::topDown(0.04, 0.0, 0.07, 0.0), JointVector{});
+  ASSERT_TRUE(r.ok()) << r.message;
+  const auto hit = checker.check(r.joints);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->fixture, "arm base");
+  // Reaching out over the table is fine.
+  const IkResult out = ik.solve(IkSolver::topDown(0.25, 0.0, 0.07, 0.0), JointVector{});
+  EXPECT_FALSE(checker.check(out.joints));
 }
 
 TEST(CollisionChecker, MovingAwayFromAnExistingContactIsAllowed) {

@@ -61,7 +61,7 @@ TEST(IkSolver, TenThousandRandomPoses) {
 
 TEST(IkSolver, NumericKdlRandomPoses) {
   IkSolver ik(testModel());
-  const Score s = score(ik, IkSolver::Method::Numeric, 2000, 43, 3.0);
+  const Score s = score(ik, IkSolver::Method::Numeric, 10000, 43, 3.0);
   EXPECT_GE(s.solved, static_cast<int>(0.995 * s.tried)) << "success " << s.solved << " / " << s.tried;
   EXPECT_LT(s.worst_position, 0.0005);
   EXPECT_LT(s.worst_angle, 0.005);

@@ -116,6 +116,51 @@ def test_services_without_a_driver(ros_master, rosrun):
     assert other["code"] == 4 and "base_link" in other["message"]
 
 
+def run_client(master, scenario, timeout=120):
+    out = subprocess.run(["/usr/bin/python3", CLIENT, scenario], env=master.env, text=True,
+                         capture_output=True, timeout=timeout)
+    lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
+    assert out.returncode == 0 and lines, out.stdout + out.stderr
+    return json.loads(lines[-1])
+
+
+@requires_controller
+def test_move_without_a_driver_times_out(ros_master, rosrun):
+    ros_master.run(["rosparam", "load", CONFIG])
+    start_controller(ros_master, rosrun)
+    out = run_client(ros_master, "no_driver")
+    assert out["error"] == "Timeout" and "/joint_states" in out["message"], out
+
+
+@requires_controller
+def test_joint_states_drive_fk_and_tf(ros_master, rosrun):
+    ros_master.run(["rosparam", "load", CONFIG])
+    start_controller(ros_master, rosrun)
+    # A driver's joint state, published by the test (sleep pose, fingers at 20 mm).
+    state = ("{name: [waist, shoulder, elbow, forearm_roll, wrist_angle, wrist_rotate, "
+             "left_finger, right_finger], position: [0.0, -1.80, 1.55, 0.0, 0.8, 0.0, 0.02, -0.02]}")
+    pub = subprocess.Popen(["rostopic", "pub", "-r", "20", "/joint_states",
+                            "sensor_msgs/JointState", state], env=ros_master.env,
+                           stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 20.0
+        fk = {"success": False}
+        while time.monotonic() < deadline and not fk["success"]:
+            fk = call(ros_master, "/rascal/arm/compute_fk", "{joints: [], link: ''}")
+            time.sleep(0.2)
+        assert fk["success"], fk
+        p = fk["pose"]["pose"]["position"]
+        assert (p["x"], p["y"], p["z"]) == pytest.approx((0.12265, 0.0, 0.08126), abs=1e-5)
+        tf = ros_master.run(["rostopic", "echo", "-n", "1", "/tf"], timeout=30).stdout
+        assert "shoulder_link" in tf and "left_finger_link" in tf
+        static = ros_master.run(["rostopic", "echo", "-n", "1", "/tf_static"], timeout=30).stdout
+        assert "camera_color_optical_frame" in static and "ee_gripper_link" in static
+    finally:
+        os.killpg(pub.pid, 2)
+        pub.wait(timeout=10)
+
+
 @requires_controller
 @requires_sim
 class TestAgainstTheSimulator:
@@ -130,12 +175,8 @@ class TestAgainstTheSimulator:
         start_controller(ros_master, rosrun)
         return ros_master
 
-    def client(self, rig, scenario, timeout=120):
-        out = subprocess.run(["/usr/bin/python3", CLIENT, scenario], env=rig.env, text=True,
-                             capture_output=True, timeout=timeout)
-        lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
-        assert out.returncode == 0 and lines, out.stdout + out.stderr
-        return json.loads(lines[-1])
+    def client(self, rig, scenario):
+        return run_client(rig, scenario)
 
     def test_pose_goal_arrives_within_2_mm(self, rig):
         out = self.client(rig, "pose_goal")
@@ -148,6 +189,12 @@ class TestAgainstTheSimulator:
         print(out)
         assert out["error"] == "Unreachable" and out["code"] == 1, out
         assert out["seconds"] < 1.0 and out["moved"] < 1e-3, out
+
+    def test_move_into_the_table_is_refused(self, rig):
+        out = self.client(rig, "collision")
+        print(out)
+        assert out["error"] == "Collision" and "table" in out["message"], out
+        assert out["moved"] < 1e-3, out
 
     def test_cancelled_move_stops(self, rig):
         out = self.client(rig, "cancel")

@@ -53,6 +53,28 @@ def unreachable(arm):
     return out
 
 
+def collision(arm):
+    arm.go("home")
+    rospy.sleep(0.5)  # the servos finish settling inside the goal tolerance
+    before = joints()
+    out = {"error": None}
+    try:
+        arm.move_to(Arm.top_down(0.25, 0.20, -0.06))  # wrist into the table
+    except ControlError as e:
+        out = error_dict(e)
+    rospy.sleep(0.3)
+    out["moved"] = max(abs(a - b) for a, b in zip(before, joints(), strict=True))
+    return out
+
+
+def no_driver(arm):
+    try:
+        arm.go("home")
+        return {"error": None}
+    except ControlError as e:
+        return error_dict(e)
+
+
 def cancel(arm):
     arm.go("home")
     client = arm._move  # the goal is sent asynchronously so it can be cancelled mid-way
@@ -103,7 +125,8 @@ def main():
         if scenario == "grasp":
             out = grasp(arm, gripper)
         else:
-            run = {"pose_goal": pose_goal, "unreachable": unreachable, "cancel": cancel}[scenario]
+            run = {"pose_goal": pose_goal, "unreachable": unreachable, "cancel": cancel,
+                   "collision": collision, "no_driver": no_driver}[scenario]
             out = run(arm)
     except ControlError as e:
         out = error_dict(e)

@@ -25,6 +25,8 @@ struct Fixture {
   // A support surface (the table, the scale platform): the fingertips may touch it, because
   // picking and placing flat sherds needs them there; every other arm body may not.
   bool support = false;
+  // Arm links allowed to touch it (the arm's own base: the links mounted on it).
+  std::set<std::string> allowed;
 };
 
 class CollisionChecker {
@@ -37,6 +39,8 @@ class CollisionChecker {
   };
 
   // `finger` [m]: finger position assumed for the fingers' bodies (0.037 = fully open, widest).
+  // The arm's own base (base_link's collision boxes) is a fixture from the start: every link but
+  // shoulder_link and upper_arm_link must keep off it.
   explicit CollisionChecker(const KinematicModel& model, double finger = 0.037);
 
   void addFixture(const Fixture& fixture);

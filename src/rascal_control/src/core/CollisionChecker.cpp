@@ -33,6 +33,7 @@ bool isFinger(const std::string& link) {
 
 CollisionChecker::CollisionChecker(const KinematicModel& model, double finger) : model_(model) {
   const KDL::Tree& tree = model_.tree();
+  std::vector<Fixture> base;
   for (const CollisionShape& shape : model_.collisionShapes()) {
     // The nearest ancestor on the arm chain carries this link.
     std::string ancestor = shape.link;
@@ -45,7 +46,14 @@ CollisionChecker::CollisionChecker(const KinematicModel& model, double finger) :
       ancestor = GetTreeElementParent(it->second)->first;
     }
     if (ancestor.empty()) {
-      continue;  // does not move with the arm (base_link)
+      // Does not move with the arm (base_link): an obstacle for the links further out.
+      const KDL::Frame centre = shape.origin;
+      double roll = 0.0, pitch = 0.0, yaw = 0.0;
+      centre.M.GetRPY(roll, pitch, yaw);
+      if (shape.type == CollisionShape::Type::Box && std::fabs(roll) + std::fabs(pitch) + std::fabs(yaw) < 1e-9) {
+        base.push_back({"arm base", centre.p, shape.size, false, {"shoulder_link", "upper_arm_link"}});
+      }
+      continue;
     }
     KDL::Chain sub;
     KDL::Frame offset = KDL::Frame::Identity();
@@ -73,6 +81,9 @@ CollisionChecker::CollisionChecker(const KinematicModel& model, double finger) :
     }
     bodies_.push_back({shape.link, model_.chainIndex(ancestor), offset * shape.origin,
                        isFinger(shape.link), std::make_shared<fcl::CollisionObjectd>(geometry)});
+  }
+  for (const Fixture& f : base) {
+    addFixture(f);
   }
   table_object_ = std::make_shared<fcl::CollisionObjectd>(
       std::make_shared<fcl::Halfspaced>(fcl::Vector3d(0.0, 0.0, 1.0), 0.0));
@@ -105,13 +116,13 @@ void CollisionChecker::addOpenBox(const std::string& name, double x, double y, d
                                   double size_y, double wall_height, double wall_thickness) {
   const double h = wall_height, t = wall_thickness;
   addFixture({name + " wall -x", KDL::Vector(x - size_x / 2.0 + t / 2.0, y, h / 2.0),
-              KDL::Vector(t, size_y, h), false});
+              KDL::Vector(t, size_y, h), false, {}});
   addFixture({name + " wall +x", KDL::Vector(x + size_x / 2.0 - t / 2.0, y, h / 2.0),
-              KDL::Vector(t, size_y, h), false});
+              KDL::Vector(t, size_y, h), false, {}});
   addFixture({name + " wall -y", KDL::Vector(x, y - size_y / 2.0 + t / 2.0, h / 2.0),
-              KDL::Vector(size_x, t, h), false});
+              KDL::Vector(size_x, t, h), false, {}});
   addFixture({name + " wall +y", KDL::Vector(x, y + size_y / 2.0 - t / 2.0, h / 2.0),
-              KDL::Vector(size_x, t, h), false});
+              KDL::Vector(size_x, t, h), false, {}});
 }
 
 void CollisionChecker::contacts(const JointVector& q, std::vector<Pair>& out,
@@ -129,6 +140,9 @@ void CollisionChecker::contacts(const JointVector& q, std::vector<Pair>& out,
         continue;
       }
       if (body.finger && (table || fixtures_[f].support)) {
+        continue;
+      }
+      if (!table && fixtures_[f].allowed.count(body.link)) {
         continue;
       }
       if (ignore && ignore->count({b, f})) {

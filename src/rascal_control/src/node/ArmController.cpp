@@ -200,7 +200,7 @@ void ArmController::readFixtures() {
       badParameter(key + "/size", "must be positive");
     }
     collisions_->addFixture({"camera stand", KDL::Vector(position[0], position[1], height / 2.0),
-                             KDL::Vector(size[0], size[1], height), false});
+                             KDL::Vector(size[0], size[1], height), false, {}});
   }
   if (ros::param::has("/stations/discard")) {
     const std::string key = "/stations/discard";
@@ -222,13 +222,21 @@ void ArmController::readFixtures() {
       badParameter(key + "/size", "must be positive");
     }
     collisions_->addFixture({"scale", KDL::Vector(position[0], position[1], top / 2.0),
-                             KDL::Vector(size[0], size[1], top), true});
+                             KDL::Vector(size[0], size[1], top), true, {}});
   }
 }
 
 void ArmController::jointStateCallback(const sensor_msgs::JointState::ConstPtr& msg) {
+  try {
+    onJointState(*msg);
+  } catch (const std::exception& e) {
+    ROS_ERROR_THROTTLE(5.0, "/joint_states: %s", e.what());
+  }
+}
+
+void ArmController::onJointState(const sensor_msgs::JointState& state) {
   std::map<std::string, double> positions, velocities;
-  jointStateToMaps(*msg, positions, velocities);
+  jointStateToMaps(state, positions, velocities);
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     for (const auto& p : positions) {
@@ -252,7 +260,7 @@ void ArmController::jointStateCallback(const sensor_msgs::JointState::ConstPtr& 
   state_cv_.notify_all();
   if (settings_.publish_tf) {
     std::vector<geometry_msgs::TransformStamped> moving;
-    const ros::Time stamp = msg->header.stamp.isZero() ? ros::Time::now() : msg->header.stamp;
+    const ros::Time stamp = state.header.stamp.isZero() ? ros::Time::now() : state.header.stamp;
     for (const LinkTransform& t : model_->transforms(positions, false)) {
       moving.push_back(toTransform(t, stamp));
     }
@@ -588,6 +596,17 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
 // Services
 
 bool ArmController::computeIk(rascal_msgs::ComputeIK::Request& req, rascal_msgs::ComputeIK::Response& res) {
+  try {
+    return solveIk(req, res);
+  } catch (const std::exception& e) {
+    ROS_ERROR("/rascal/arm/compute_ik: %s", e.what());
+    res.code = rascal_msgs::ComputeIK::Response::INVALID;
+    res.message = std::string("internal error: ") + e.what();
+    return true;
+  }
+}
+
+bool ArmController::solveIk(rascal_msgs::ComputeIK::Request& req, rascal_msgs::ComputeIK::Response& res) {
   const std::string& frame = req.pose.header.frame_id;
   KDL::Frame target;
   std::string why;
@@ -622,6 +641,17 @@ bool ArmController::computeIk(rascal_msgs::ComputeIK::Request& req, rascal_msgs:
 }
 
 bool ArmController::computeFk(rascal_msgs::ComputeFK::Request& req, rascal_msgs::ComputeFK::Response& res) {
+  try {
+    return solveFk(req, res);
+  } catch (const std::exception& e) {
+    ROS_ERROR("/rascal/arm/compute_fk: %s", e.what());
+    res.success = false;
+    res.message = std::string("internal error: ") + e.what();
+    return true;
+  }
+}
+
+bool ArmController::solveFk(rascal_msgs::ComputeFK::Request& req, rascal_msgs::ComputeFK::Response& res) {
   JointVector q{};
   double finger = kFingerMin;
   {

@@ -53,6 +53,7 @@ class ArmController {
   void readFixtures();
 
   void jointStateCallback(const sensor_msgs::JointState::ConstPtr& msg);
+  void onJointState(const sensor_msgs::JointState& msg);
   // Latest arm joints; waits up to the state timeout (wall time) for the first message.
   bool currentJoints(JointVector& q, double wait);
 
@@ -64,6 +65,8 @@ class ArmController {
 
   bool computeIk(rascal_msgs::ComputeIK::Request& req, rascal_msgs::ComputeIK::Response& res);
   bool computeFk(rascal_msgs::ComputeFK::Request& req, rascal_msgs::ComputeFK::Response& res);
+  bool solveIk(rascal_msgs::ComputeIK::Request& req, rascal_msgs::ComputeIK::Response& res);
+  bool solveFk(rascal_msgs::ComputeFK::Request& req, rascal_msgs::ComputeFK::Response& res);
 
   ros::NodeHandle nh_;
   Settings settings_;

@@ -61,6 +61,10 @@ class Arm:
             if not move_client.wait_for_server(rospy.Duration(wait)):
                 raise Timeout(3, "no /rascal/arm/move action server within %.0f s; is "
                                  "arm_controller running?" % wait)
+            try:
+                rospy.wait_for_service("/rascal/arm/compute_ik", wait)
+            except rospy.ROSException as e:
+                raise Timeout(3, "no /rascal/arm/compute_ik service within %.0f s" % wait) from e
             ik_service = rospy.ServiceProxy("/rascal/arm/compute_ik", ComputeIK)
             fk_service = rospy.ServiceProxy("/rascal/arm/compute_fk", ComputeFK)
         self._move = move_client
