@@ -138,7 +138,8 @@ def test_joint_states_drive_fk_and_tf(ros_master, rosrun):
     start_controller(ros_master, rosrun)
     # A driver's joint state, published by the test (sleep pose, fingers at 20 mm).
     state = ("{name: [waist, shoulder, elbow, forearm_roll, wrist_angle, wrist_rotate, "
-             "left_finger, right_finger], position: [0.0, -1.80, 1.55, 0.0, 0.8, 0.0, 0.02, -0.02]}")
+             "left_finger, right_finger], "
+             "position: [0.0, -1.80, 1.55, 0.0, 0.8, 0.0, 0.02, -0.02]}")
     pub = subprocess.Popen(["rostopic", "pub", "-r", "20", "/joint_states",
                             "sensor_msgs/JointState", state], env=ros_master.env,
                            stdout=subprocess.DEVNULL,
