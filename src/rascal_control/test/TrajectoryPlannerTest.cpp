@@ -124,6 +124,41 @@ TEST(TrajectoryPlanner, LinearMoveStaysOnTheLine) {
   }
 }
 
+TEST(TrajectoryPlanner, RandomTopDownLinearMoves) {
+  IkSolver ik(testModel());
+  TrajectoryPlanner planner(testModel(), ik, nullptr);
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> ux(0.12, 0.40), uy(-0.30, 0.30), uz(0.02, 0.25), uyaw(-1.0, 1.0);
+  int planned = 0;
+  for (int n = 0; n < 60; ++n) {
+    const KDL::Frame from = IkSolver::topDown(ux(rng), uy(rng), uz(rng), uyaw(rng));
+    const KDL::Frame to = IkSolver::topDown(ux(rng), uy(rng), uz(rng), uyaw(rng));
+    const IkResult start = ik.solve(from, JointVector{});
+    if (!start.ok()) {
+      continue;
+    }
+    const PlanResult r = planner.planLinear(start.joints, to, 1.0);
+    if (!r.ok()) {
+      EXPECT_EQ(r.code, PlanCode::Unreachable) << r.message;
+      continue;
+    }
+    ++planned;
+    double v = 0, acc = 0, fd = 0;
+    limitRatios(r.trajectory, 1.0, v, acc, fd);
+    EXPECT_LE(v, 1.0 + 1e-6);
+    EXPECT_LE(acc, 1.0 + 1e-6);
+    double worst = 0.0;
+    const KDL::Vector ab = to.p - from.p;
+    for (double t = 0.0; t <= r.trajectory.duration(); t += kDt) {
+      const KDL::Vector p = testModel().forward(r.trajectory.sample(t).q).p;
+      const double u = std::min(1.0, std::max(0.0, KDL::dot(p - from.p, ab) / KDL::dot(ab, ab)));
+      worst = std::max(worst, (p - (from.p + ab * u)).Norm());
+    }
+    EXPECT_LT(worst, 0.001);
+  }
+  EXPECT_GT(planned, 40);
+}
+
 TEST(TrajectoryPlanner, LinearMoveToAnUnreachablePointFails) {
   IkSolver ik(testModel());
   TrajectoryPlanner planner(testModel(), ik, nullptr);

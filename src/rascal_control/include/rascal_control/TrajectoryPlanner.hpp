@@ -45,9 +45,9 @@ class TrajectoryPlanner {
   // ee_gripper_link along the straight line (orientation interpolated) from FK(start) to `goal`.
   PlanResult planLinear(const JointVector& start, const KDL::Frame& goal, double speed_scale);
 
-  // Scales a trajectory's time so that it stays inside the limits (samples every `dt`);
-  // returns the factor used (1 = unchanged).
-  double enforceLimits(Trajectory& trajectory, double speed_scale, double dt = 0.001) const;
+  // Scales a trajectory's time so that it stays inside the limits, checked every `dt` and on
+  // both sides of every piece boundary; returns the factor used (1 = unchanged).
+  double enforceLimits(Trajectory& trajectory, double speed_scale, double dt = 0.0001) const;
 
   const Options& options() const { return options_; }
 

@@ -269,20 +269,33 @@ TimeScaling TrajectoryPlanner::timeOptimal(const JointPath& path, double speed_s
 }
 
 double TrajectoryPlanner::enforceLimits(Trajectory& trajectory, double speed_scale, double dt) const {
-  double ratio_v = 0.0, ratio_a = 0.0;
-  const double total = trajectory.duration();
-  for (double t = 0.0; t <= total + dt; t += dt) {
-    const Trajectory::Sample sample = trajectory.sample(std::min(t, total));
-    for (std::size_t j = 0; j < kArmJoints; ++j) {
-      ratio_v = std::max(ratio_v, std::fabs(sample.qd[j]) / (model_.limits()[j].velocity * speed_scale));
-      ratio_a = std::max(ratio_a, std::fabs(sample.qdd[j]) / (options_.max_acceleration * speed_scale));
+  double total_factor = 1.0;
+  for (int pass = 0; pass < 3; ++pass) {
+    double ratio_v = 0.0, ratio_a = 0.0;
+    auto check = [&](double t) {
+      const Trajectory::Sample sample = trajectory.sample(t);
+      for (std::size_t j = 0; j < kArmJoints; ++j) {
+        ratio_v = std::max(ratio_v, std::fabs(sample.qd[j]) / (model_.limits()[j].velocity * speed_scale));
+        ratio_a = std::max(ratio_a, std::fabs(sample.qdd[j]) / (options_.max_acceleration * speed_scale));
+      }
+    };
+    const double total = trajectory.duration();
+    const auto steps = static_cast<long>(std::ceil(total / dt));
+    for (long k = 0; k <= steps; ++k) {
+      check(std::min(total, static_cast<double>(k) * dt));
     }
+    for (const TimeScaling::Piece& piece : trajectory.timing().pieces()) {
+      check(std::max(0.0, piece.t0 - 1e-9));
+      check(std::min(total, piece.t0 + 1e-9));
+    }
+    const double factor = std::max({1.0, ratio_v, std::sqrt(ratio_a)});
+    if (factor <= 1.0) {
+      break;
+    }
+    trajectory = Trajectory(trajectory.path(), trajectory.timing().stretched(factor * 1.0005));
+    total_factor *= factor * 1.0005;
   }
-  const double factor = std::max({1.0, ratio_v, std::sqrt(ratio_a)});
-  if (factor > 1.0) {
-    trajectory = Trajectory(trajectory.path(), trajectory.timing().stretched(factor * 1.001));
-  }
-  return factor;
+  return total_factor;
 }
 
 }  // namespace rascal_control
