@@ -185,6 +185,11 @@ class TestAgainstTheSimulator:
         assert "error" not in out, out
         assert out["joint_error"] < 0.002 and out["linear_error"] < 0.002, out
 
+    def test_linear_move_is_executed_along_the_line(self, rig):
+        out = self.client(rig, "linear_path")
+        print(out)
+        assert out["samples"] > 20 and out["deviation"] < 0.002, out
+
     def test_unreachable_goal_fails_fast_and_does_not_move(self, rig):
         out = self.client(rig, "unreachable")
         print(out)

@@ -39,6 +39,26 @@ def pose_goal(arm):
     return {"joint_error": first, "linear_error": pose_error(arm, 0.25, -0.05, 0.10)}
 
 
+def linear_path(arm):
+    """Executed path of a linear move: every /joint_states message of the move through FK."""
+    a, b = (0.20, 0.20, 0.12), (0.35, -0.10, 0.05)
+    arm.move_to(Arm.top_down(*a, yaw=0.2))
+    samples = []
+    sub = rospy.Subscriber("/joint_states", JointState,
+                           lambda m: samples.append(dict(zip(m.name, m.position, strict=False))))
+    result = arm.move_to(Arm.top_down(*b, yaw=-0.4), motion="linear")
+    sub.unregister()
+    ab = [q - p for p, q in zip(a, b, strict=True)]
+    worst = 0.0
+    for s in samples[::2]:
+        p = arm.compute_fk([s[n] for n in ARM]).pose.position
+        ap = (p.x - a[0], p.y - a[1], p.z - a[2])
+        u = max(0.0, min(1.0, sum(x * y for x, y in zip(ap, ab, strict=True))
+                         / sum(x * x for x in ab)))
+        worst = max(worst, math.dist((p.x, p.y, p.z), [a[i] + u * ab[i] for i in range(3)]))
+    return {"samples": len(samples), "deviation": worst, "duration": result.duration}
+
+
 def unreachable(arm):
     before = joints()
     start = time.monotonic()
@@ -126,7 +146,8 @@ def main():
             out = grasp(arm, gripper)
         else:
             run = {"pose_goal": pose_goal, "unreachable": unreachable, "cancel": cancel,
-                   "collision": collision, "no_driver": no_driver}[scenario]
+                   "collision": collision, "no_driver": no_driver,
+                   "linear_path": linear_path}[scenario]
             out = run(arm)
     except ControlError as e:
         out = error_dict(e)
