@@ -77,7 +77,7 @@ def test_publishes_images_and_point_clouds(ros_master, sim):
     cloud = echo(ros_master, "/camera/depth/color/points", noarr=True)
     width = [int(s.split(":")[1]) for s in cloud.splitlines() if s.startswith("width:")][0]
     assert width > 1000
-    assert "point_step: 32" in cloud  # x, y, z, pad, rgb as set by PointCloud2Modifier
+    assert "point_step: 16" in cloud  # x, y, z, rgb as float32
 
 
 def test_capture_refused_while_arm_in_view_then_stored(ros_master, sim, tmp_path):

@@ -11,6 +11,10 @@ struct Mesh {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<std::array<int, 3>> triangles;
   std::vector<Eigen::Vector3f> colours;  ///< linear RGB per triangle
+  bool cull_back_faces = false;          ///< closed, outward-wound: back faces are never visible
+  double radius = -1.0;                  ///< bounding sphere about the origin (updateBounds())
+
+  void updateBounds();
 
   void addTriangle(int a, int b, int c, const Eigen::Vector3f& linear_rgb);
   /// Adds an axis-aligned box (centre, size) with one sRGB colour.

@@ -1,6 +1,7 @@
 #pragma once
 // Software rasteriser with a z-buffer: flat-shaded triangles, pinhole projection, near-plane
-// clipping. Produces linear-RGB radiance and metric depth (z along the optical axis).
+// clipping. Produces an 8-bit sRGB image lit by a global linear gain, metric depth (z along the
+// optical axis) and a label image.
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -17,7 +18,7 @@ struct RenderItem {
 };
 
 struct RenderOutput {
-  cv::Mat radiance;  ///< CV_32FC3 linear RGB, 0 where nothing was drawn
+  cv::Mat colour;    ///< CV_8UC3 sRGB (RGB order), 0 where nothing was drawn
   cv::Mat depth;     ///< CV_32FC1 [m], 0 where nothing was drawn
   cv::Mat label;     ///< CV_16UC1 RenderItem::id of the visible surface, 0 = none
 };
@@ -25,8 +26,14 @@ struct RenderOutput {
 class Renderer {
  public:
   /// `world_T_camera` is the optical frame in the world.
+  /// `gain` multiplies the linear radiance of every surface (brightness x colour temperature).
   void render(const std::vector<RenderItem>& items, const CameraModel& camera,
-              const Eigen::Isometry3d& world_T_camera, RenderOutput& out) const;
+              const Eigen::Isometry3d& world_T_camera, RenderOutput& out,
+              const Eigen::Vector3f& gain = Eigen::Vector3f::Ones()) const;
+  /// 8-bit sRGB of a linear value (clamped to [0, 1]).
+  static uint8_t encodeSrgb(float linear);
+  /// Linear value of an 8-bit sRGB code.
+  static float decodeSrgb(uint8_t code);
 
  private:
   mutable std::vector<Eigen::Vector3d> cam_vertices_;

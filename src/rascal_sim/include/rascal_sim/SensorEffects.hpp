@@ -23,10 +23,12 @@ class SensorEffects {
   /// sigma of the depth noise at distance z [m].
   static double depthSigma(double z) { return z * z * kSubpixelSigma / (kDepthFocal * kBaseline); }
 
-  /// 8-bit sRGB image (CV_8UC3, RGB order) from rendered radiance and depth.
-  cv::Mat colourImage(const cv::Mat& radiance, const cv::Mat& depth, const CameraModel& camera,
-                      const Eigen::Isometry3d& world_T_camera, const Lighting& lighting, double t,
-                      double blur_px);
+  /// Linear gain of the scenario's light (brightness x colour temperature) for the renderer.
+  static Eigen::Vector3f lightGain(const Lighting& lighting);
+  /// Adds the moving shadow, motion blur and colour noise to a rendered sRGB image (in place).
+  void colourImage(cv::Mat& colour, const cv::Mat& depth, const CameraModel& camera,
+                   const Eigen::Isometry3d& world_T_camera, const Lighting& lighting, double t,
+                   double blur_px);
   /// CV_16UC1 depth in mm with noise, quantisation, min-Z holes and the left invalid band.
   cv::Mat depthImage(const cv::Mat& depth, const CameraModel& camera, bool left_band = true);
 

@@ -53,6 +53,11 @@ void Mesh::addRect(double cx, double cy, double sx, double sy, double z,
   addTriangle(base, base + 2, base + 3, lin);
 }
 
+void Mesh::updateBounds() {
+  radius = 0.0;
+  for (const auto& v : vertices) radius = std::max(radius, v.norm());
+}
+
 double Mesh::volume() const {
   double v = 0.0;
   for (const auto& t : triangles) {

@@ -11,13 +11,13 @@ struct ClipVertex {
 };
 
 struct Target {
-  cv::Mat* radiance;
+  cv::Mat* colour;
   cv::Mat* depth;
   cv::Mat* label;
 };
 
 void rasterTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                    const CameraModel& cam, const Eigen::Vector3f& colour, int id, Target& t) {
+                    const CameraModel& cam, const cv::Vec3b& col, int id, Target& t) {
   const double ua = cam.fx * a.x() / a.z() + cam.cx, va = cam.fy * a.y() / a.z() + cam.cy;
   const double ub = cam.fx * b.x() / b.z() + cam.cx, vb = cam.fy * b.y() / b.z() + cam.cy;
   const double uc = cam.fx * c.x() / c.z() + cam.cx, vc = cam.fy * c.y() / c.z() + cam.cy;
@@ -36,7 +36,6 @@ void rasterTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Ei
   const double w0o = (ub * vc - vb * uc) * inv_area;  // value at (0, 0)
   const double w1o = (uc * va - vc * ua) * inv_area;
   const double izx = w0x * iza + w1x * izb - (w0x + w1x) * izc;
-  const cv::Vec3f col(colour.x(), colour.y(), colour.z());
   const uint16_t lid = static_cast<uint16_t>(id);
   const double eps = 1e-9;
   for (int y = y0; y <= y1; ++y) {
@@ -60,13 +59,13 @@ void rasterTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Ei
     if (empty || lo > hi) continue;
     const int xs = std::max(x0, static_cast<int>(std::ceil(lo))), xe = std::min(x1, static_cast<int>(std::floor(hi)));
     float* drow = t.depth->ptr<float>(y);
-    cv::Vec3f* crow = t.radiance->ptr<cv::Vec3f>(y);
+    cv::Vec3b* crow = t.colour->ptr<cv::Vec3b>(y);
     uint16_t* lrow = t.label->ptr<uint16_t>(y);
-    const double izr = a0 * iza + a1 * izb + a2 * izc;
+    const float izr = static_cast<float>(a0 * iza + a1 * izb + a2 * izc), izxf = static_cast<float>(izx);
     for (int x = xs; x <= xe; ++x) {
-      const double iz = izr + izx * x;
-      if (iz <= 0) continue;
-      const float z = static_cast<float>(1.0 / iz);
+      const float iz = izr + izxf * x;
+      if (iz <= 0.0f) continue;
+      const float z = 1.0f / iz;
       if (drow[x] != 0.0f && z >= drow[x]) continue;
       drow[x] = z;
       crow[x] = col;
@@ -76,21 +75,60 @@ void rasterTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Ei
 }
 }  // namespace
 
+uint8_t Renderer::encodeSrgb(float linear) {
+  static const std::vector<uint8_t> lut = [] {
+    std::vector<uint8_t> l(4097);
+    for (int i = 0; i <= 4096; ++i) {
+      const double c = i / 4096.0;
+      const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+      l[i] = static_cast<uint8_t>(std::lround(std::min(1.0, s) * 255));
+    }
+    return l;
+  }();
+  const int i = static_cast<int>(linear * 4096.0f + 0.5f);
+  return lut[i < 0 ? 0 : (i > 4096 ? 4096 : i)];
+}
+
+float Renderer::decodeSrgb(uint8_t code) {
+  static const std::vector<float> lut = [] {
+    std::vector<float> l(256);
+    for (int i = 0; i < 256; ++i) {
+      const double c = i / 255.0;
+      l[i] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    }
+    return l;
+  }();
+  return lut[code];
+}
+
 void Renderer::render(const std::vector<RenderItem>& items, const CameraModel& cam,
-                      const Eigen::Isometry3d& world_T_camera, RenderOutput& out) const {
-  out.radiance.create(cam.height, cam.width, CV_32FC3);
-  out.radiance.setTo(cv::Scalar::all(0));
+                      const Eigen::Isometry3d& world_T_camera, RenderOutput& out,
+                      const Eigen::Vector3f& gain) const {
+  out.colour.create(cam.height, cam.width, CV_8UC3);
+  out.colour.setTo(cv::Scalar::all(0));
   out.depth.create(cam.height, cam.width, CV_32FC1);
   out.depth.setTo(cv::Scalar::all(0));
   out.label.create(cam.height, cam.width, CV_16UC1);
   out.label.setTo(cv::Scalar::all(0));
-  Target target{&out.radiance, &out.depth, &out.label};
+  Target target{&out.colour, &out.depth, &out.label};
   const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
   const Eigen::Vector3d light = Eigen::Vector3d(0.25, 0.15, 1.0).normalized();
   for (const RenderItem& item : items) {
     if (!item.mesh) continue;
     const Mesh& m = *item.mesh;
     const Eigen::Isometry3d T = camera_T_world * item.pose;
+    if (m.radius >= 0.0) {
+      // whole item outside the view frustum?
+      const Eigen::Vector3d c = T.translation();
+      const double r = m.radius;
+      if (c.z() < cam.near - r || c.z() > cam.far + r) continue;
+      const double kx = cam.width / (2.0 * cam.fx) + std::abs(cam.cx - cam.width / 2.0) / cam.fx;
+      const double ky = cam.height / (2.0 * cam.fy) + std::abs(cam.cy - cam.height / 2.0) / cam.fy;
+      const double zc = std::max(c.z(), 0.0);
+      if (std::abs(c.x()) - r * std::sqrt(1 + kx * kx) > kx * zc + r || std::abs(c.y()) - r * std::sqrt(1 + ky * ky) > ky * zc + r) {
+        continue;
+      }
+    }
     cam_vertices_.resize(m.vertices.size());
     for (size_t i = 0; i < m.vertices.size(); ++i) cam_vertices_[i] = T * m.vertices[i];
     for (size_t k = 0; k < m.triangles.size(); ++k) {
@@ -99,12 +137,14 @@ void Renderer::render(const std::vector<RenderItem>& items, const CameraModel& c
       const Eigen::Vector3d& b = cam_vertices_[tri[1]];
       const Eigen::Vector3d& c = cam_vertices_[tri[2]];
       if (a.z() > cam.far && b.z() > cam.far && c.z() > cam.far) continue;
+      if (m.cull_back_faces && (b - a).cross(c - a).dot(a) >= 0.0) continue;
       const Eigen::Vector3d n_local = (m.vertices[tri[1]] - m.vertices[tri[0]]).cross(m.vertices[tri[2]] - m.vertices[tri[0]]);
       const double len = n_local.norm();
       if (len < 1e-15) continue;
       const Eigen::Vector3d n = item.pose.linear() * (n_local / len);
       const float shade = static_cast<float>(0.35 + 0.65 * std::abs(n.dot(light)));
-      const Eigen::Vector3f colour = m.colours[k] * shade;
+      const Eigen::Vector3f lin = m.colours[k].cwiseProduct(gain) * shade;
+      const cv::Vec3b colour(encodeSrgb(lin.x()), encodeSrgb(lin.y()), encodeSrgb(lin.z()));
       const Eigen::Vector3d* v[3] = {&a, &b, &c};
       int inside = 0;
       for (auto* p : v) inside += p->z() >= cam.near;

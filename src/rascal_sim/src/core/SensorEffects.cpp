@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "rascal_sim/Mesh.hpp"
+#include "rascal_sim/Renderer.hpp"
 
 namespace rascal_sim {
 
@@ -13,11 +14,6 @@ constexpr size_t kGaussTable = 1 << 21;
 constexpr double kDepthCx = 319.0;  // [px] D435 depth at 640 x 480 (facts §4.3)
 constexpr double kShadowPeriod = 60.0;  // [s] the shadow's path repeats
 
-uint8_t encodeSrgb(float linear) {
-  const double c = std::min(1.0f, std::max(0.0f, linear));
-  const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
-  return static_cast<uint8_t>(std::lround(std::min(1.0, s) * 255));
-}
 }  // namespace
 
 SensorEffects::SensorEffects(unsigned seed) : rng_(seed), gauss_(kGaussTable) {
@@ -43,52 +39,62 @@ Eigen::Vector3d SensorEffects::temperatureGains(double kelvin) {
   return g / (0.2126 * g.x() + 0.7152 * g.y() + 0.0722 * g.z());
 }
 
-cv::Mat SensorEffects::colourImage(const cv::Mat& radiance, const cv::Mat& depth, const CameraModel& cam,
-                                   const Eigen::Isometry3d& world_T_camera, const Lighting& lighting,
-                                   double t, double blur_px) {
-  const Eigen::Vector3d gain = temperatureGains(lighting.colour_temperature) * lighting.brightness;
-  const float g0 = static_cast<float>(gain.x()), g1 = static_cast<float>(gain.y()), g2 = static_cast<float>(gain.z());
-  const bool shadow = lighting.shadow_strength > 0.0;
+Eigen::Vector3f SensorEffects::lightGain(const Lighting& lighting) {
+  return (temperatureGains(lighting.colour_temperature) * lighting.brightness).cast<float>();
+}
+
+void SensorEffects::colourImage(cv::Mat& img, const cv::Mat& depth, const CameraModel& cam,
+                                const Eigen::Isometry3d& world_T_camera, const Lighting& lighting,
+                                double t, double blur_px) {
   const Eigen::Vector2d centre = lighting.shadow_start + lighting.shadow_velocity * std::fmod(t, kShadowPeriod);
-  const float r_out = static_cast<float>(lighting.shadow_radius), r_in = 0.6f * r_out;
-  const float strength = static_cast<float>(lighting.shadow_strength);
-  const Eigen::Matrix3d R = world_T_camera.linear();
-  const Eigen::Vector3d p0 = world_T_camera.translation();
-  // world ray of pixel (x, y) = row + x * dx (per unit depth)
-  const Eigen::Vector3d dx = R.col(0) / cam.fx;
-  const float dxx = static_cast<float>(dx.x()), dxy = static_cast<float>(dx.y());
-  const float cx0 = static_cast<float>(p0.x() - centre.x()), cy0 = static_cast<float>(p0.y() - centre.y());
-  const float r_out2 = r_out * r_out;
-  static const std::vector<uint8_t> lut = [] {
-    std::vector<uint8_t> l(4097);
-    for (int i = 0; i <= 4096; ++i) l[i] = encodeSrgb(i / 4096.0f);
-    return l;
-  }();
-  auto enc = [](float v) {
-    const int i = static_cast<int>(v * 4096.0f + 0.5f);
-    return lut[i < 0 ? 0 : (i > 4096 ? 4096 : i)];
-  };
-  cv::Mat img(cam.height, cam.width, CV_8UC3);
-  for (int y = 0; y < cam.height; ++y) {
-    const cv::Vec3f* rrow = radiance.ptr<cv::Vec3f>(y);
-    const float* drow = depth.ptr<float>(y);
-    cv::Vec3b* out = img.ptr<cv::Vec3b>(y);
-    const Eigen::Vector3d row = R * Eigen::Vector3d(-cam.cx / cam.fx, (y - cam.cy) / cam.fy, 1.0);
-    const float rx = static_cast<float>(row.x()), ry = static_cast<float>(row.y());
-    for (int x = 0; x < cam.width; ++x) {
-      float f = 1.0f;
-      const float z = drow[x];
-      if (shadow && z > 0.0f) {
+  const double r_out = lighting.shadow_radius;
+  if (lighting.shadow_strength > 0.0) {
+    // image box of the shadow disc (table level up to 5 cm above it)
+    const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
+    double u0 = 1e9, v0 = 1e9, u1 = -1e9, v1 = -1e9;
+    bool behind = false;
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d w(centre.x() + ((i & 1) ? r_out : -r_out), centre.y() + ((i & 2) ? r_out : -r_out),
+                              (i & 4) ? 0.05 : 0.0);
+      const Eigen::Vector3d c = camera_T_world * w;
+      if (c.z() < 1e-3) {
+        behind = true;
+        break;
+      }
+      const Eigen::Vector2d uv = cam.project(c);
+      u0 = std::min(u0, uv.x());
+      u1 = std::max(u1, uv.x());
+      v0 = std::min(v0, uv.y());
+      v1 = std::max(v1, uv.y());
+    }
+    const int xa = behind ? 0 : std::max(0, static_cast<int>(u0));
+    const int xb = behind ? cam.width - 1 : std::min(cam.width - 1, static_cast<int>(u1) + 1);
+    const int ya = behind ? 0 : std::max(0, static_cast<int>(v0));
+    const int yb = behind ? cam.height - 1 : std::min(cam.height - 1, static_cast<int>(v1) + 1);
+    const float ro = static_cast<float>(r_out), ri = 0.6f * ro, ro2 = ro * ro;
+    const float strength = static_cast<float>(lighting.shadow_strength);
+    const Eigen::Matrix3d R = world_T_camera.linear();
+    const Eigen::Vector3d p0 = world_T_camera.translation();
+    const Eigen::Vector3d dx = R.col(0) / cam.fx;  // world ray of pixel (x, y) = row(y) + x * dx
+    const float dxx = static_cast<float>(dx.x()), dxy = static_cast<float>(dx.y());
+    const float cx0 = static_cast<float>(p0.x() - centre.x()), cy0 = static_cast<float>(p0.y() - centre.y());
+    for (int y = ya; y <= yb; ++y) {
+      const float* drow = depth.ptr<float>(y);
+      cv::Vec3b* row_px = img.ptr<cv::Vec3b>(y);
+      const Eigen::Vector3d row = R * Eigen::Vector3d(-cam.cx / cam.fx, (y - cam.cy) / cam.fy, 1.0);
+      const float rx = static_cast<float>(row.x()), ry = static_cast<float>(row.y());
+      for (int x = xa; x <= xb; ++x) {
+        const float z = drow[x];
+        if (z <= 0.0f) continue;
         const float wx = cx0 + z * (rx + x * dxx), wy = cy0 + z * (ry + x * dxy);
         const float d2 = wx * wx + wy * wy;
-        if (d2 < r_out2) {
-          const float d = std::sqrt(d2);
-          const float s = d <= r_in ? 1.0f : (r_out - d) / (r_out - r_in);
-          f = 1.0f - strength * s * s * (3.0f - 2.0f * s);
-        }
+        if (d2 >= ro2) continue;
+        const float d = std::sqrt(d2);
+        const float s = d <= ri ? 1.0f : (ro - d) / (ro - ri);
+        const float f = 1.0f - strength * s * s * (3.0f - 2.0f * s);
+        cv::Vec3b& px = row_px[x];
+        for (int c = 0; c < 3; ++c) px[c] = Renderer::encodeSrgb(Renderer::decodeSrgb(px[c]) * f);
       }
-      const cv::Vec3f& c = rrow[x];
-      out[x] = cv::Vec3b(enc(c[0] * g0 * f), enc(c[1] * g1 * f), enc(c[2] * g2 * f));
     }
   }
   if (blur_px >= 1.5) {
@@ -113,7 +119,6 @@ cv::Mat SensorEffects::colourImage(const cv::Mat& radiance, const cv::Mat& depth
       p[i] = static_cast<uint8_t>(v < 0 ? 0 : (v > 255 ? 255 : v));
     }
   }
-  return img;
 }
 
 cv::Mat SensorEffects::depthImage(const cv::Mat& depth, const CameraModel& cam, bool left_band) {

@@ -145,6 +145,8 @@ SherdGeometry SherdMeshBuilder::build(const SherdSpec& spec) {
     for (const auto& p : outline) g.outline.push_back(p - centre.head<2>());
   }
   g.mass = g.volume * spec.density;
+  g.mesh.cull_back_faces = spec.mesh_file.empty();  // our shells are wound outwards
+  g.mesh.updateBounds();
   return g;
 }
 

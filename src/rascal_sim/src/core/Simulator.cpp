@@ -128,15 +128,15 @@ WristFrame Simulator::renderWristFrame() {
   f.world_T_camera = wristCameraPose();
   world_.renderItems(items_, true);
   const CameraModel& cam = options_.wrist_model;
-  renderer_.render(items_, cam, f.world_T_camera, scratch_);
+  renderer_.render(items_, cam, f.world_T_camera, scratch_, SensorEffects::lightGain(scenario_.lighting));
   const double speed = std::max(servos_.maxSpeed(), 0.0);
   double blur = 0.0;
   if (speed > kBlurSpeed) {
     f.blurred = true;
     blur = std::max(3.0, speed * cam.fx * kExposure);
   }
-  f.rgb = effects_.colourImage(scratch_.radiance, scratch_.depth, cam, f.world_T_camera, scenario_.lighting,
-                               f.stamp, blur);
+  effects_.colourImage(scratch_.colour, scratch_.depth, cam, f.world_T_camera, scenario_.lighting, f.stamp, blur);
+  f.rgb = scratch_.colour.clone();
   f.depth_mm = effects_.depthImage(scratch_.depth, cam);
   skipWristFrame();
   return f;
@@ -150,9 +150,9 @@ void Simulator::skipWristFrame() {
 cv::Mat Simulator::renderArchival() {
   world_.renderItems(items_, true);
   RenderOutput out;
-  renderer_.render(items_, archival_.model(), archival_.pose(), out);
-  return effects_.colourImage(out.radiance, out.depth, archival_.model(), archival_.pose(), scenario_.lighting,
-                              time(), 0.0);
+  renderer_.render(items_, archival_.model(), archival_.pose(), out, SensorEffects::lightGain(scenario_.lighting));
+  effects_.colourImage(out.colour, out.depth, archival_.model(), archival_.pose(), scenario_.lighting, time(), 0.0);
+  return out.colour;
 }
 
 bool Simulator::triggerCapture(std::string& why) {

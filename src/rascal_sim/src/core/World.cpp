@@ -247,6 +247,8 @@ struct World::Impl {
       dGeomSetData(g, tag(k, b.link));
       Mesh lm;
       lm.addBox(Eigen::Vector3d::Zero(), b.size, b.srgb);
+      lm.cull_back_faces = true;
+      lm.updateBounds();
       link_meshes.push_back(lm);
     }
   }
@@ -292,6 +294,8 @@ World::World(const WorldLayout& layout) : impl_(new Impl), layout_(layout) {
   w.space = dHashSpaceCreate(nullptr);
   w.contact_group = dJointGroupCreate(0);
   w.buildFixtures(layout);
+  w.fixtures.cull_back_faces = true;  // boxes wound outwards, rectangles face up
+  w.fixtures.updateBounds();
   w.buildPhysics(layout);
   JointVector q{0.0, -1.80, 1.55, 0.0, 0.8, 0.0};
   placeArm(q, ArmKinematics::kFingerMax);

@@ -69,7 +69,9 @@ sensor_msgs::PointCloud2 toPointCloud(const cv::Mat& depth_mm, const cv::Mat& rg
   m.header.frame_id = frame;
   m.header.stamp = stamp;
   sensor_msgs::PointCloud2Modifier mod(m);
-  mod.setPointCloud2FieldsByString(2, "xyz", "rgb");
+  // x, y, z, rgb as float32, no padding: 16 bytes a point
+  mod.setPointCloud2Fields(4, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32,
+                           "z", 1, sensor_msgs::PointField::FLOAT32, "rgb", 1, sensor_msgs::PointField::FLOAT32);
   size_t n = static_cast<size_t>(cv::countNonZero(depth_mm));
   mod.resize(n);
   m.height = 1;

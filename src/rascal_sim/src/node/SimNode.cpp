@@ -5,6 +5,8 @@
 #include <rascal_msgs/ScaleReading.h>
 #include <sensor_msgs/JointState.h>
 
+#include <malloc.h>
+
 #include <chrono>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -30,6 +32,9 @@ std::string resolve(const std::string& root, const std::string& path) {
 }  // namespace
 
 SimNode::SimNode(ros::NodeHandle& nh) {
+  // image buffers are allocated every frame: keep them on the heap instead of fresh mmap pages
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   readParameters(nh);
   munsell_ = std::make_unique<MunsellTable>(layout_.data_dir + "/munsell_soil_hues_grid_renotation.csv");
   ScenarioLoader loader(layout_, *munsell_);
@@ -95,7 +100,7 @@ void SimNode::readParameters(ros::NodeHandle&) {
   scenario_path_ = resolve(workspace_, p.text("/simulator/scenario"));
   real_time_factor_ = p.number("/simulator/real_time_factor", 0.0, 0.0, 100.0);
   options_.physics_dt = p.number("/simulator/physics_step", 0.001, 0.0002, 0.002);
-  clock_period_ = p.number("/simulator/clock_period", 0.001, options_.physics_dt, 0.1);
+  clock_period_ = p.number("/simulator/clock_period", 0.005, options_.physics_dt, 0.1);
   joint_state_period_ = p.number("/simulator/joint_state_period", 0.01, options_.physics_dt, 0.01);
   options_.wrist_camera = p.flag("/simulator/wrist_camera", true);
   options_.wrist_rate = p.number("/simulator/wrist_rate", 30.0, 1.0, 30.0);
