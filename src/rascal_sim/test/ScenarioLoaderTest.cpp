@@ -95,3 +95,15 @@ TEST(ScenarioLoader, ErrorsNameTheKey) {
     EXPECT_NE(std::string(e.what()).find("lighting.brightness"), std::string::npos) << e.what();
   }
 }
+
+TEST(ScenarioLoader, ShippedScenariosLoad) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  const std::string dir = std::string(RASCAL_SIM_DATA_DIR) + "/../../../config/scenarios/";
+  const Scenario demo = loader.load(dir + "demo_10.yaml");
+  EXPECT_EQ(demo.sherds.size(), 10u);
+  const Scenario small = loader.load(dir + "small_3.yaml");
+  ASSERT_EQ(small.sherds.size(), 3u);
+  EXPECT_FALSE(small.sherds[2].mesh_file.empty());
+  for (const auto& s : demo.sherds) EXPECT_NO_THROW(SherdMeshBuilder::build(s)) << s.name;
+}

@@ -70,9 +70,8 @@ TEST(Simulator, CaptureArrivesShutterPlusTransferLater) {
   EXPECT_EQ(sim.archival().image().cols, 400);
 }
 
-TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
-  SimulatorOptions o = quiet();
-  // gripper pointing down over (0.30, 0.20), fingers open, found on a coarse grid
+/// Gripper pointing down over (0.30, 0.20) with the fingertips 6 mm above the table.
+static JointVector overSherd() {
   JointVector best{};
   double best_err = 1e9;
   const double waist = std::atan2(0.20, 0.30), r = std::hypot(0.30, 0.20);
@@ -87,11 +86,14 @@ TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
       }
     }
   }
-  o.initial_joints = best;
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), o);
+  return best;
+}
+
+/// Grasps a centred sherd (across its minor axis) and lifts it by 0.3 rad of shoulder.
+static void graspAndLift(Simulator& sim, const JointVector& start) {
   Scenario sc;
   SherdSpec s = slab("c", 0.30, 0.20, 1850);
-  s.pose.z() = waist;  // fingers close across the sherd's minor axis
+  s.pose.z() = std::atan2(0.20, 0.30);  // fingers close across the sherd's minor axis
   sc.sherds = {s};
   sc.seed = 3;
   sim.load(sc);
@@ -100,15 +102,54 @@ TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
   for (int i = 0; i < 800; ++i) sim.step();
   EXPECT_TRUE(sim.groundTruth()[0].held);
   EXPECT_NEAR(sim.fingerPosition(), 0.0175, 0.002);  // stopped on the 35 mm wide sherd
-  // lift: shoulder back a little
   TrajectoryPoint p;
-  p.positions = best;
+  p.positions = start;
   p.positions[1] -= 0.3;
   p.positions[4] += 0.3;
   p.time_from_start = 1.0;
   sim.commandArm(sim.time(), {p}, {true, true, true, true, true, true});
   for (int i = 0; i < 1500; ++i) sim.step();
+}
+
+TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
+  SimulatorOptions o = quiet();
+  o.initial_joints = overSherd();
+  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), o);
+  graspAndLift(sim, o.initial_joints);
   const auto truth = sim.groundTruth()[0];
   EXPECT_TRUE(truth.held);
   EXPECT_GT(truth.pose.translation().z(), 0.03);
+}
+
+TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {
+  SimulatorOptions o = quiet();
+  o.initial_joints = overSherd();
+  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), o);
+  std::string message;
+  ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kDropNextGrasp), 0.0, message));
+  graspAndLift(sim, o.initial_joints);
+  for (int i = 0; i < 2000; ++i) sim.step();
+  const auto truth = sim.groundTruth()[0];
+  EXPECT_FALSE(truth.held);
+  EXPECT_LT(truth.pose.translation().z(), 0.03);
+  EXPECT_LT(truth.linear_velocity.norm(), 1e-2);
+  EXPECT_LT(sim.fingerPosition(), 0.0155);  // nothing left between the fingers
+}
+
+TEST(Simulator, ScaleGlitchMakesReadingsUnstable) {
+  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());
+  std::string message;
+  EXPECT_FALSE(sim.injectFault(static_cast<int>(Fault::kScaleGlitch), 0.0, message));
+  ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kScaleGlitch), 1.0, message));
+  ScaleReading r;
+  bool any_stable = false;
+  for (int i = 0; i < 1000; ++i) {
+    sim.step();
+    if (sim.takeScaleReading(r)) any_stable = any_stable || r.stable;
+  }
+  EXPECT_FALSE(any_stable);
+  for (int i = 0; i < 1500; ++i) sim.step();
+  sim.takeScaleReading(r);
+  EXPECT_TRUE(r.stable);
+  EXPECT_NEAR(r.mass, 0.0, 1e-4);
 }
