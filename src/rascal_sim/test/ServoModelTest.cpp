@@ -63,3 +63,31 @@ TEST(ServoModel, StaysInsideJointLimits) {
   EXPECT_LE(servo.positions()[1], ArmKinematics::upperLimits()[1] + 1e-12);
   EXPECT_NEAR(servo.positions()[1], ArmKinematics::upperLimits()[1], 0.01);
 }
+
+TEST(ServoModel, FeasibleTrajectoryIsTrackedClosely) {
+  ServoModel servo(JointVector{0, 0, 0, 0, 0, 0});
+  // a triangular profile at the acceleration limit: 1 rad in 2 * sqrt(1 / 5) s, points every 10 ms
+  const double a = 5.0, th = std::sqrt(1.0 / a), total = 2 * th;
+  std::vector<TrajectoryPoint> points;
+  for (double t = 0.0; t <= total + 1e-9; t += 0.01) {
+    TrajectoryPoint p;
+    const double s = t <= th ? 0.5 * a * t * t : 1.0 - 0.5 * a * (total - t) * (total - t);
+    const double v = t <= th ? a * t : a * (total - t);
+    p.positions = {s, 0, 0, 0, 0, 0};
+    p.velocities = {v, 0, 0, 0, 0, 0};
+    p.has_velocities = true;
+    p.time_from_start = t;
+    points.push_back(p);
+  }
+  servo.setTrajectory(0.0, 0.2, points, {true, true, true, true, true, true});
+  double worst = 0.0, t = 0.0;
+  for (; t < 0.2 + total; t += 0.001) {
+    servo.step(t, 0.001);
+    const double tau = std::min(total, std::max(0.0, t + 0.001 - 0.2));
+    const double ref = tau <= th ? 0.5 * a * tau * tau : 1.0 - 0.5 * a * (total - tau) * (total - tau);
+    worst = std::max(worst, std::abs(servo.positions()[0] - ref));
+  }
+  EXPECT_LT(worst, 0.02);
+  for (int i = 0; i < 500; ++i, t += 0.001) servo.step(t, 0.001);
+  EXPECT_TRUE(servo.settled());
+}

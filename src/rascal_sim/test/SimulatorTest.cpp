@@ -153,3 +153,18 @@ TEST(Simulator, ScaleGlitchMakesReadingsUnstable) {
   EXPECT_TRUE(r.stable);
   EXPECT_NEAR(r.mass, 0.0, 1e-4);
 }
+
+TEST(Simulator, CameraTimeoutFaultAnswersOnlyAfterItsDuration) {
+  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());
+  std::string message;
+  ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kCameraTimeout), 1.0, message)) << message;
+  std::string why;
+  ASSERT_TRUE(sim.triggerCapture(why)) << why;
+  EXPECT_EQ(sim.archival().state(), ArchivalCamera::State::kFailed);
+  EXPECT_NEAR(sim.archival().readyTime(), sim.time() + 1.0, 1e-9);
+  EXPECT_NE(sim.archival().message().find("did not answer"), std::string::npos);
+  sim.archival().acknowledge();
+  for (int i = 0; i < 1100; ++i) sim.step();
+  ASSERT_TRUE(sim.triggerCapture(why)) << why;
+  EXPECT_EQ(sim.archival().state(), ArchivalCamera::State::kShutter);
+}

@@ -34,8 +34,8 @@ void ServoModel::setTrajectory(double now, double start_time, const std::vector<
   first.positions = q_ref;
   first.time_from_start = 0.0;
   next.push_back(first);
+  // a trajectory that arrives late is played from now with its own timing (not skipped ahead)
   const double start = std::max(start_time, now);
-  const double shift = start - start_time;  // a late trajectory keeps its timing from `now`
   for (const auto& p : points) {
     TrajectoryPoint c = p;
     for (int j = 0; j < kArmJoints; ++j) {
@@ -44,7 +44,7 @@ void ServoModel::setTrajectory(double now, double start_time, const std::vector<
         c.velocities[j] = 0.0;
       }
     }
-    c.time_from_start = std::max(0.0, p.time_from_start - shift);
+    c.time_from_start = std::max(0.0, p.time_from_start);
     if (c.time_from_start <= next.back().time_from_start) {
       // a point at (or before) the start replaces the start
       if (next.size() == 1) c.time_from_start = 0.0;
