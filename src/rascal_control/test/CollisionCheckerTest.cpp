@@ -93,6 +93,33 @@ TEST(CollisionChecker, TheArmKeepsOffItsOwnBase) {
   EXPECT_FALSE(checker.check(out.joints));
 }
 
+TEST(CollisionChecker, JointMoveToAPoseTriesOtherSolutions) {
+  IkSolver ik(testModel());
+  CollisionChecker checker(testModel());
+  addStations(checker);
+  TrajectoryPlanner planner(testModel(), ik, &checker);
+  // Near the camera station: the move to the closest IK solution swings the wrist camera into the
+  // stand; another solution of the same pose gets there without touching it.
+  const IkResult start = ik.solve(IkSolver::topDown(0.434, -0.198, 0.035, -0.033), JointVector{});
+  ASSERT_TRUE(start.ok());
+  const KDL::Frame to = IkSolver::topDown(0.295, -0.343, 0.137, -0.103);
+  const auto all = ik.solveAll(to, start.joints);
+  ASSERT_GE(all.size(), 2u);
+  for (const JointVector& q : all) {
+    EXPECT_TRUE(KDL::Equal(testModel().forward(q), to, 1e-9));
+    EXPECT_TRUE(testModel().withinLimits(q));
+  }
+  const PlanResult closest = planner.planJoint(start.joints, all.front(), 1.0);
+  EXPECT_EQ(closest.code, PlanCode::Collision);
+  EXPECT_NE(closest.message.find("camera stand"), std::string::npos) << closest.message;
+  const PlanResult r = planner.planJointToPose(start.joints, to, 1.0);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_FALSE(checker.check(r.trajectory.path()));
+  EXPECT_TRUE(KDL::Equal(testModel().forward(r.trajectory.goal()), to, 1e-9));
+  EXPECT_EQ(planner.planJointToPose(start.joints, IkSolver::topDown(1.0, 0, 0.1, 0), 1.0).code,
+            PlanCode::Unreachable);
+}
+
 TEST(CollisionChecker, MovingAwayFromAnExistingContactIsAllowed) {
   IkSolver ik(testModel());
   CollisionChecker checker(testModel());

@@ -6,6 +6,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <kdl/chainiksolverpos_lma.hpp>
 #include <kdl/frames.hpp>
@@ -38,6 +39,10 @@ class IkSolver {
   IkResult solve(const KDL::Frame& target, const JointVector& seed, Method method = Method::Auto);
 
   const KinematicModel& model() const { return model_; }
+  // Every solution inside the limits, closest to `seed` first (the closed form's up to 8; with
+  // KDL only, just solve()'s answer). Empty when solve() fails.
+  std::vector<JointVector> solveAll(const KDL::Frame& target, const JointVector& seed);
+
   bool analyticAvailable() const { return static_cast<bool>(analytic_); }
   // Why the closed form is not used (empty when it is).
   const std::string& analyticUnavailableReason() const { return analytic_why_; }

@@ -42,6 +42,9 @@ class TrajectoryPlanner {
   // Synchronised rest-to-rest move along the joint-space line: the trapezoid of the slowest joint.
   // speed_scale in (0, 1] scales the speed and acceleration limits.
   PlanResult planJoint(const JointVector& start, const JointVector& goal, double speed_scale) const;
+  // Joint move to a pose: the IK solution closest to `start` whose move is collision-free (the
+  // others are tried in order of distance when the closest one's move would collide).
+  PlanResult planJointToPose(const JointVector& start, const KDL::Frame& goal, double speed_scale);
   // ee_gripper_link along the straight line (orientation interpolated) from FK(start) to `goal`.
   PlanResult planLinear(const JointVector& start, const KDL::Frame& goal, double speed_scale);
 

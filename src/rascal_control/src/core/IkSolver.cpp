@@ -1,6 +1,7 @@
 #include "rascal_control/IkSolver.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 
@@ -136,6 +137,37 @@ IkResult IkSolver::solve(const KDL::Frame& target, const JointVector& seed, Meth
     }
   }
   return solveNumeric(target, seed);
+}
+
+std::vector<JointVector> IkSolver::solveAll(const KDL::Frame& target, const JointVector& seed) {
+  const IkResult best = solve(target, seed);
+  if (!best.ok()) {
+    return {};
+  }
+  std::vector<std::pair<double, JointVector>> found{{distance(best.joints, seed), best.joints}};
+  std::vector<JointVector> solutions;
+  double reach_error = 0.0;
+  if (analytic_ && analytic_->solveAll(target, seed, solutions, reach_error)) {
+    for (JointVector q : solutions) {
+      if (!intoLimits(q, seed) || !accurate(target, q)) {
+        continue;
+      }
+      bool known = false;
+      for (const auto& f : found) {
+        known = known || distance(f.second, q) < 1e-12;
+      }
+      if (!known) {
+        found.emplace_back(distance(q, seed), q);
+      }
+    }
+  }
+  std::stable_sort(found.begin(), found.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<JointVector> out;
+  for (const auto& f : found) {
+    out.push_back(f.second);
+  }
+  return out;
 }
 
 IkResult IkSolver::solveAnalytic(const KDL::Frame& target, const JointVector& seed, bool& verified) {

@@ -128,6 +128,33 @@ PlanResult TrajectoryPlanner::planJoint(const JointVector& start, const JointVec
   return result;
 }
 
+PlanResult TrajectoryPlanner::planJointToPose(const JointVector& start, const KDL::Frame& goal,
+                                              double speed_scale) {
+  PlanResult result;
+  if (!validStart(start, speed_scale, result)) {
+    return result;
+  }
+  const IkResult ik = ik_.solve(goal, start);
+  if (!ik.ok()) {
+    result.code = ik.code == IkCode::Invalid ? PlanCode::InvalidGoal : PlanCode::Unreachable;
+    result.message = ik.message;
+    return result;
+  }
+  PlanResult first;
+  bool have_first = false;
+  for (const JointVector& q : ik_.solveAll(goal, start)) {
+    PlanResult r = planJoint(start, q, speed_scale);
+    if (r.code != PlanCode::Collision) {
+      return r;
+    }
+    if (!have_first) {
+      first = r;
+      have_first = true;
+    }
+  }
+  return have_first ? first : planJoint(start, ik.joints, speed_scale);
+}
+
 PlanResult TrajectoryPlanner::planLinear(const JointVector& start, const KDL::Frame& goal,
                                          double speed_scale) {
   PlanResult result;

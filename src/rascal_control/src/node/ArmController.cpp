@@ -327,17 +327,8 @@ PlanResult ArmController::plan(const rascal_msgs::MoveArmGoal& goal, const Joint
         failed.message = "pose goal: " + why;
         return failed;
       }
-      if (linear) {
-        return planner_->planLinear(start, target_pose, scale);
-      }
-      const IkResult ik = ik_->solve(target_pose, start);
-      if (!ik.ok()) {
-        failed.code = ik.code == IkCode::Invalid ? PlanCode::InvalidGoal : PlanCode::Unreachable;
-        failed.message = ik.message;
-        return failed;
-      }
-      target_joints = ik.joints;
-      break;
+      return linear ? planner_->planLinear(start, target_pose, scale)
+                    : planner_->planJointToPose(start, target_pose, scale);
     }
     case rascal_msgs::MoveArmGoal::TARGET_NAMED: {
       const auto it = settings_.named_poses.find(goal.named_pose);
