@@ -32,14 +32,15 @@ ScenarioGenerator::ScenarioGenerator(const MunsellTable& munsell) : munsell_(mun
 
 std::vector<Eigen::Vector2d> ScenarioGenerator::irregularOutline(double length, double width,
                                                                  std::mt19937& rng) {
-  const int n = 9 + static_cast<int>(rng() % 5);
+  // few corners and uneven radii: broken edges are straight-ish with sharp corners
+  const int n = 6 + static_cast<int>(rng() % 5);
   std::vector<double> radius(n);
-  for (auto& r : radius) r = uniform(rng, 0.78, 1.08);
+  for (auto& r : radius) r = uniform(rng, 0.70, 1.10);
   std::vector<Eigen::Vector2d> pts;
   for (int i = 0; i < n; ++i) {
     const double a = 2 * kPi * (i + uniform(rng, -0.3, 0.3)) / n;
-    // light smoothing keeps the broken edges straight-ish but not spiky
-    const double r = 0.5 * radius[i] + 0.25 * radius[(i + 1) % n] + 0.25 * radius[(i + n - 1) % n];
+    // light smoothing keeps the outline from getting spiky
+    const double r = 0.7 * radius[i] + 0.15 * radius[(i + 1) % n] + 0.15 * radius[(i + n - 1) % n];
     pts.emplace_back(r * std::cos(a), r * std::sin(a));
   }
   Eigen::Vector2d lo = pts[0], hi = pts[0];
