@@ -2,6 +2,8 @@
 
 #include <sensor_msgs/point_cloud2_iterator.h>
 
+#include <cstdint>
+
 #include <cstring>
 
 namespace rascal_sim {
@@ -77,21 +79,22 @@ sensor_msgs::PointCloud2 toPointCloud(const cv::Mat& depth_mm, const cv::Mat& rg
   m.height = 1;
   m.width = static_cast<uint32_t>(n);
   m.is_dense = true;
-  sensor_msgs::PointCloud2Iterator<float> x(m, "x"), y(m, "y"), z(m, "z");
-  sensor_msgs::PointCloud2Iterator<uint8_t> c(m, "rgb");
+  struct Point {
+    float x, y, z;
+    uint8_t b, g, r, a;  // float32 rgb field: 0x00RRGGBB, little-endian
+  };
+  static_assert(sizeof(Point) == 16, "point layout");
+  Point* out = reinterpret_cast<Point*>(m.data.data());
+  const float ifx = static_cast<float>(1.0 / cam.fx), ify = static_cast<float>(1.0 / cam.fy);
+  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
   for (int v = 0; v < depth_mm.rows; ++v) {
     const uint16_t* d = depth_mm.ptr<uint16_t>(v);
     const cv::Vec3b* col = rgb.ptr<cv::Vec3b>(v);
+    const float ny = (v - cy) * ify;
     for (int u = 0; u < depth_mm.cols; ++u) {
       if (d[u] == 0) continue;
       const float zz = d[u] * 0.001f;
-      *x = static_cast<float>((u - cam.cx) / cam.fx) * zz;
-      *y = static_cast<float>((v - cam.cy) / cam.fy) * zz;
-      *z = zz;
-      c[0] = col[u][2];  // packed as b, g, r in memory (little-endian 0x00RRGGBB)
-      c[1] = col[u][1];
-      c[2] = col[u][0];
-      ++x, ++y, ++z, ++c;
+      *out++ = {(u - cx) * ifx * zz, ny * zz, zz, col[u][2], col[u][1], col[u][0], 0};
     }
   }
   return m;
