@@ -97,7 +97,9 @@ ArmController::ArmController(ros::NodeHandle& private_nh) : nh_(private_nh) {
   ik_ = std::make_unique<IkSolver>(*model_);
   collisions_ = std::make_unique<CollisionChecker>(*model_);
   readFixtures();
-  planner_ = std::make_unique<TrajectoryPlanner>(*model_, *ik_, collisions_.get());
+  TrajectoryPlanner::Options options;
+  options.max_acceleration *= settings_.acceleration_share;
+  planner_ = std::make_unique<TrajectoryPlanner>(*model_, *ik_, collisions_.get(), options);
 
   // 2. Topics, services, actions.
   ros::NodeHandle root("/");
@@ -173,6 +175,7 @@ void ArmController::readSettings() {
     settings_.named_poses[it->first] = q;
   }
   settings_.speed_scale = readNumber("/arm/speed_scale", 1.0, 0.0, 1.0, true);
+  settings_.acceleration_share = readNumber("/arm/acceleration_share", 0.95, 0.0, 1.0, true);
   settings_.command_period = readNumber("/arm/command_period", 0.02, 0.0, 0.1, true);
   settings_.goal_tolerance = readNumber("/arm/goal_tolerance", 0.002, 0.0, 0.1, true);
   settings_.settle_timeout = readNumber("/arm/settle_timeout", 2.0, 0.0, 60.0, true);

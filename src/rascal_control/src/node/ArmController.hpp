@@ -38,6 +38,7 @@ class ArmController {
   struct Settings {
     std::map<std::string, JointVector> named_poses;
     double speed_scale = 1.0;
+    double acceleration_share = 0.95;
     double command_period = 0.02;
     double goal_tolerance = 0.002;
     double settle_timeout = 2.0;
