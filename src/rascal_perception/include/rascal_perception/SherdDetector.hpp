@@ -1,0 +1,69 @@
+#pragma once
+// The whole pipeline per station: calibrate a background model on the empty station, then detect
+// sherds (segment -> separate -> measure -> grasp -> order). The calibration view is carried to a
+// later camera pose through the homography of the station plane, so the survey may move.
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rascal_perception/BackgroundModel.hpp"
+#include "rascal_perception/GraspPlanner.hpp"
+#include "rascal_perception/SherdMeasurer.hpp"
+#include "rascal_perception/SherdSegmenter.hpp"
+#include "rascal_perception/Types.hpp"
+
+namespace rascal_perception {
+
+struct CalibrationResult {
+  bool success = false;
+  std::string message;
+  int clusters = 0;
+  double fixture_fraction = 0.0;  ///< share of the image masked as fixture (after dilation)
+};
+
+class SherdDetector {
+ public:
+  explicit SherdDetector(const PerceptionConfig& config);
+  /// Learns `station`'s background from an image of it empty. `depth_mm` may be empty.
+  CalibrationResult calibrate(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                              const CameraView& view, double surface_z);
+  /// Re-learns the station's colours from a frame with sherds in it (the sherds left out).
+  CalibrationResult refresh(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                            const CameraView& view, double surface_z);
+  /// Sherds in base_link, ordered by the selection policy. `depth_mm` may be empty (no heights).
+  DetectionResult detect(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                         const CameraView& view, double surface_z);
+  /// Segmentation only: the blobs and the foreground mask (for benches and the annotated image).
+  std::vector<Blob> segment(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                            const CameraView& view, double surface_z, cv::Mat& foreground,
+                            SegmentationStats* stats = nullptr);
+  bool calibrated(const std::string& station) const { return stations_.count(station) > 0; }
+  const BackgroundModel* model(const std::string& station) const;
+  const PerceptionConfig& config() const { return config_; }
+  void setSelectionPolicy(SelectionPolicy policy) { config_.selection_policy = policy; }
+
+ private:
+  struct Station {
+    BackgroundModel model;
+    CameraView view;
+    double surface_z = 0.0;
+    cv::Mat fixture;  ///< dilated, calibration view
+  };
+  /// The station's seen-map and fixture mask in the present view.
+  void warpPriors(const Station& s, const CameraView& view, double surface_z, cv::Mat& allowed, cv::Mat& fixture) const;
+  /// 255 where the depth is more than min_sherd_height above the surface.
+  cv::Mat raised(const cv::Mat& depth_mm, const CameraView& view, double surface_z);
+  /// [px per m] at the station surface along the optical axis.
+  double pixelsPerMetre(const CameraView& view, double surface_z) const;
+
+  PerceptionConfig config_;
+  std::map<std::string, Station> stations_;
+  SherdSegmenter segmenter_;
+  SherdMeasurer measurer_;
+  GraspPlanner planner_;
+  cv::Mat ray_z_;
+  Eigen::Matrix3d ray_z_rotation_ = Eigen::Matrix3d::Zero();
+  cv::Mat allowed_, fixture_, usable_;
+};
+
+}  // namespace rascal_perception

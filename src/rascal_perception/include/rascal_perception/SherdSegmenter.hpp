@@ -1,0 +1,42 @@
+#pragma once
+// Colour image -> sherd blobs: background and fixtures removed, holes filled, blobs cut by the
+// image border rejected, touching sherds separated (distance transform + watershed).
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "rascal_perception/BackgroundModel.hpp"
+#include "rascal_perception/Types.hpp"
+
+namespace rascal_perception {
+
+struct SegmentationOptions {
+  double min_side_px = 10.0;     ///< blobs with a shorter oriented-box side are noise
+  double max_side_px = 1e9;      ///< blobs with a longer side are not one sherd
+  int border_margin = 3;         ///< [px]
+  double split_min_neck = 0.75;  ///< see PerceptionConfig
+  bool split = true;
+};
+
+struct SegmentationStats {
+  int rejected_border = 0, rejected_size = 0, splits = 0;
+};
+
+class SherdSegmenter {
+ public:
+  /// Foreground = not background (per `allowed`, see BackgroundModel::classify) and not `fixture`,
+  /// or-ed with `raised` (CV_8U 255: pixels the depth shows above the surface; may be empty).
+  /// Returns the blobs; `foreground` receives the cleaned mask.
+  std::vector<Blob> segment(const cv::Mat& rgb, const BackgroundModel& model, const cv::Mat& allowed,
+                            const cv::Mat& fixture, const cv::Mat& raised, const SegmentationOptions& options,
+                            cv::Mat& foreground, SegmentationStats* stats = nullptr) const;
+  /// Blobs of a binary mask (no colour model): contours, border and size checks, splitting.
+  std::vector<Blob> blobs(const cv::Mat& mask, const SegmentationOptions& options,
+                          SegmentationStats* stats = nullptr) const;
+  /// Splits one filled blob mask at its necks; returns 1 mask if it is one sherd.
+  std::vector<cv::Mat> split(const cv::Mat& mask, double min_neck, double min_peak_px) const;
+
+ private:
+  mutable cv::Mat hsv_, background_;
+};
+
+}  // namespace rascal_perception

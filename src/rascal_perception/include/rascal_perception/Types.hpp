@@ -1,0 +1,83 @@
+#pragma once
+// Value types shared by the perception core: camera intrinsics, the configuration (perception.*
+// of config/rascal.yaml), segmented blobs and measured sherds. No ROS.
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace rascal_perception {
+
+/// Pinhole intrinsics of the colour stream (the aligned depth shares them).
+struct CameraIntrinsics {
+  int width = 640, height = 480;
+  double fx = 615.0, fy = 615.0, cx = 320.0, cy = 240.0;
+  /// Direction of pixel (u, v) in the optical frame with z = 1.
+  Eigen::Vector3d ray(double u, double v) const { return {(u - cx) / fx, (v - cy) / fy, 1.0}; }
+  Eigen::Vector2d project(const Eigen::Vector3d& p) const {
+    return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
+  }
+};
+
+enum class SelectionPolicy { kNearest, kLargest, kMostIsolated };
+/// "nearest" | "largest" | "most_isolated"; throws std::invalid_argument otherwise.
+SelectionPolicy parseSelectionPolicy(const std::string& name);
+
+/// perception.* of config/rascal.yaml (+ arm.grasp_margin). Lengths in metres.
+struct PerceptionConfig {
+  int background_clusters = 3;
+  double hue_tolerance = 0.15;         ///< half-width of a cluster's hue band, fraction of the hue circle
+  double saturation_tolerance = 0.35;  ///< half-width of a cluster's saturation band, S in [0, 1]
+  double min_value = 0.07;             ///< darker pixels (V in [0, 1]) are not trusted for hue
+  double fixture_dilation = 0.01;      ///< [m] growth of the fixture mask
+  double min_sherd_size = 0.015;       ///< [m] shortest side of the smallest sherd
+  double max_sherd_size = 0.12;        ///< [m] longest side of the largest sherd
+  int border_margin = 3;               ///< [px] blobs this close to the border are cut off
+  SelectionPolicy selection_policy = SelectionPolicy::kNearest;
+  double depth_min = 0.15, depth_max = 1.0;  ///< [m] depth outside is ignored
+  double grasp_margin = 0.012;         ///< [m] arm.grasp_margin: opening beyond the measured width
+  double grasp_height_fraction = 0.6;  ///< fingertips close at this fraction of the measured height
+  double grasp_tip_clearance = 0.005;  ///< [m] fingertips never lower than this above the surface
+  double fingertip_offset = 0.0044;    ///< [m] fingertips below ee_gripper_link (finger box end)
+  double split_min_neck = 0.75;        ///< touching sherds split where the neck < this x the smaller peak
+  double plane_tolerance = 0.003;      ///< [m] RANSAC inlier distance of the table plane
+  double min_sherd_height = 0.0025;    ///< [m] depth this far above the surface is sherd, whatever its colour
+};
+
+/// A segmented region of the colour image (one sherd candidate).
+struct Blob {
+  std::vector<cv::Point> contour;  ///< outer contour in image pixels
+  cv::RotatedRect box;             ///< minAreaRect of the contour
+  cv::Rect bounds;                 ///< bounding rectangle
+  cv::Mat mask;                    ///< CV_8U 255 inside, size of `bounds`
+  int pixels = 0;
+};
+
+/// One measured sherd (all poses in base_link).
+struct SherdDetection {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< [m] top-surface centre
+  double yaw = 0.0;            ///< [rad] major axis about +z, in (-pi/2, pi/2]
+  double length = 0.0, width = 0.0, height = 0.0, area = 0.0;  ///< [m], [m^2]
+  double surface = 0.0;        ///< [m] z of the station surface (fitted plane) under the centre
+  Eigen::Vector3d colour = Eigen::Vector3d::Zero();  ///< mean sRGB [0, 1]
+  Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();  ///< ee_gripper_link target
+  double grasp_width = 0.0;    ///< [m] opening before closing, 0.030 .. 0.074
+  double score = 0.0;          ///< [1] in [0, 1]
+  double clearance = 1.0;      ///< [m] gap to the nearest other sherd (1 = alone)
+  bool depth_valid = false;    ///< false: measured without depth (height unknown = 0)
+  float image_box[5] = {0, 0, 0, 0, 0};  ///< u, v, length, width [px], angle [rad]
+  std::vector<Eigen::Vector3d> outline;  ///< [m] top-view outline, z = station surface
+  std::vector<cv::Point> contour;        ///< image contour (for drawing)
+};
+
+/// Result of a detection: the sherds ordered by the selection policy, or why there are none.
+struct DetectionResult {
+  bool success = false;
+  std::string message;
+  std::vector<SherdDetection> sherds;
+  Eigen::Vector4d plane = Eigen::Vector4d(0, 0, 1, 0);  ///< table plane in base_link, n.p + d = 0
+  int plane_inliers = 0;
+  int rejected_border = 0, rejected_size = 0, splits = 0;
+};
+
+}  // namespace rascal_perception

@@ -1,0 +1,158 @@
+#include "rascal_perception/BackgroundModel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace rascal_perception {
+
+namespace {
+constexpr double kTwoPi = 6.283185307179586;
+constexpr double kValueWeight = 0.1;  ///< value is nearly ignored by the clustering
+
+double hueDistance(double a, double b) {
+  double d = std::fabs(a - b);
+  return d > 0.5 ? 1.0 - d : d;
+}
+}  // namespace
+
+void BackgroundModel::learn(const cv::Mat& rgb, const BackgroundOptions& options, const cv::Mat& ignore) {
+  if (rgb.empty() || rgb.type() != CV_8UC3) {
+    throw std::invalid_argument("BackgroundModel::learn: need a CV_8UC3 RGB image");
+  }
+  if (options.clusters < 1 || options.clusters > 8) {
+    throw std::invalid_argument("BackgroundModel::learn: clusters must be 1..8");
+  }
+  options_ = options;
+  cv::Mat hsv;
+  cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV_FULL);
+  cluster(hsv, ignore);
+
+  // where each cluster was seen (grown), and what matched nothing: the fixtures
+  const int vmin = static_cast<int>(std::lround(options_.min_value * 255.0));
+  cv::Mat bits(hsv.size(), CV_8U), fixture(hsv.size(), CV_8U);
+  for (int y = 0; y < hsv.rows; ++y) {
+    const cv::Vec3b* p = hsv.ptr<cv::Vec3b>(y);
+    uint8_t* b = bits.ptr<uint8_t>(y);
+    uint8_t* f = fixture.ptr<uint8_t>(y);
+    for (int x = 0; x < hsv.cols; ++x) {
+      const bool dark = p[x][2] < vmin;
+      b[x] = dark ? 0 : match(p[x][0], p[x][1]);
+      f[x] = (!dark && b[x] == 0) ? 255 : 0;
+    }
+  }
+  if (!ignore.empty()) fixture.setTo(0, ignore);
+  cv::morphologyEx(fixture, fixture_, cv::MORPH_OPEN, cv::Mat::ones(3, 3, CV_8U));
+  seen_ = cv::Mat::zeros(hsv.size(), CV_8U);
+  const int r = std::max(0, options_.prior_dilation_px);
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+  for (size_t c = 0; c < clusters_.size(); ++c) {
+    cv::Mat m = (bits & cv::Scalar(1 << c)) != 0;
+    if (r > 0) cv::dilate(m, m, kernel);
+    cv::bitwise_or(seen_, cv::Scalar(1 << c), seen_, m);
+  }
+  // dark calibration pixels say nothing: any cluster may appear there
+  seen_.setTo(0xFF, (bits == 0) & (fixture_ == 0));
+}
+
+void BackgroundModel::refresh(const cv::Mat& rgb, const cv::Mat& ignore) {
+  if (!ready()) throw std::logic_error("BackgroundModel::refresh: learn() first");
+  cv::Mat hsv;
+  cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV_FULL);
+  const size_t before = clusters_.size();
+  cluster(hsv, ignore);
+  if (clusters_.size() != before) seen_.setTo(0xFF);  // cluster indices changed: no prior
+}
+
+void BackgroundModel::cluster(const cv::Mat& hsv, const cv::Mat& ignore) {
+  const int vmin = static_cast<int>(std::lround(options_.min_value * 255.0));
+  const int step = std::max(1, static_cast<int>(std::sqrt(hsv.total() / 20000.0)));
+  std::vector<cv::Vec3f> samples;
+  std::vector<cv::Vec3f> hsv_samples;
+  samples.reserve(hsv.total() / (step * step) + 1);
+  for (int y = step / 2; y < hsv.rows; y += step) {
+    const cv::Vec3b* p = hsv.ptr<cv::Vec3b>(y);
+    for (int x = step / 2; x < hsv.cols; x += step) {
+      if (p[x][2] < vmin) continue;
+      if (!ignore.empty() && ignore.at<uint8_t>(y, x)) continue;
+      const float h = p[x][0] / 256.0f, s = p[x][1] / 255.0f, v = p[x][2] / 255.0f;
+      samples.emplace_back(s * std::cos(kTwoPi * h), s * std::sin(kTwoPi * h), kValueWeight * v);
+      hsv_samples.emplace_back(h, s, v);
+    }
+  }
+  const int k = std::min<int>(options_.clusters, static_cast<int>(samples.size()));
+  if (k < 1) throw std::invalid_argument("BackgroundModel::learn: the image is too dark to learn from");
+  cv::Mat data(static_cast<int>(samples.size()), 3, CV_32F, samples.data());
+  cv::Mat labels, centres;
+  cv::theRNG().state = options_.seed;
+  cv::kmeans(data, k, labels, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4), 3,
+             cv::KMEANS_PP_CENTERS, centres);
+  struct Acc { double c = 0, s = 0, sat = 0, v = 0; int n = 0; };
+  std::vector<Acc> acc(k);
+  for (size_t i = 0; i < hsv_samples.size(); ++i) {
+    Acc& a = acc[labels.at<int>(static_cast<int>(i))];
+    const cv::Vec3f& q = hsv_samples[i];
+    a.c += std::cos(kTwoPi * q[0]);
+    a.s += std::sin(kTwoPi * q[0]);
+    a.sat += q[1];
+    a.v += q[2];
+    ++a.n;
+  }
+  clusters_.clear();
+  for (const Acc& a : acc) {
+    if (a.n == 0) continue;
+    BackgroundCluster c;
+    c.fraction = static_cast<double>(a.n) / hsv_samples.size();
+    if (c.fraction < options_.min_cluster_fraction) continue;
+    double h = std::atan2(a.s, a.c) / kTwoPi;
+    c.hue = h < 0 ? h + 1.0 : h;
+    c.saturation = a.sat / a.n;
+    c.value = a.v / a.n;
+    c.grey = c.saturation < options_.grey_saturation;
+    clusters_.push_back(c);
+  }
+  std::sort(clusters_.begin(), clusters_.end(),
+            [](const BackgroundCluster& a, const BackgroundCluster& b) { return a.fraction > b.fraction; });
+  buildLut();
+}
+
+void BackgroundModel::buildLut() {
+  lut_.assign(256 * 256, 0);
+  for (int h = 0; h < 256; ++h) {
+    for (int s = 0; s < 256; ++s) {
+      uint8_t bits = 0;
+      for (size_t c = 0; c < clusters_.size(); ++c) {
+        const BackgroundCluster& k = clusters_[c];
+        // loose, but in proportion: a pale cluster must not swallow every grey
+        const double band = std::min(options_.saturation_tolerance, std::max(0.5 * k.saturation, 0.08));
+        if (std::fabs(s / 255.0 - k.saturation) > band) continue;
+        if (!k.grey && hueDistance(h / 256.0, k.hue) > options_.hue_tolerance) continue;
+        bits |= static_cast<uint8_t>(1 << c);
+      }
+      lut_[h * 256 + s] = bits;
+    }
+  }
+}
+
+void BackgroundModel::classify(const cv::Mat& hsv, const cv::Mat& allowed, cv::Mat& background) const {
+  if (!ready()) throw std::logic_error("BackgroundModel::classify: no model learnt");
+  const int vmin = static_cast<int>(std::lround(options_.min_value * 255.0));
+  background.create(hsv.size(), CV_8U);
+  const bool any = allowed.empty();
+  for (int y = 0; y < hsv.rows; ++y) {
+    const cv::Vec3b* p = hsv.ptr<cv::Vec3b>(y);
+    const uint8_t* a = any ? nullptr : allowed.ptr<uint8_t>(y);
+    uint8_t* o = background.ptr<uint8_t>(y);
+    for (int x = 0; x < hsv.cols; ++x) {
+      if (p[x][2] < vmin) {
+        o[x] = 255;
+        continue;
+      }
+      const uint8_t bits = lut_[p[x][0] * 256 + p[x][1]];
+      o[x] = (any ? bits : (bits & a[x])) ? 255 : 0;
+    }
+  }
+}
+
+}  // namespace rascal_perception

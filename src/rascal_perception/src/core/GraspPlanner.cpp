@@ -1,0 +1,55 @@
+#include "rascal_perception/GraspPlanner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rascal_perception {
+
+namespace {
+/// Distance from point p to segment ab in the xy plane.
+double segmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+double outlineGap(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& p : a) {
+    for (size_t i = 0; i < b.size(); ++i) {
+      best = std::min(best, segmentDistance(p.head<2>(), b[i].head<2>(), b[(i + 1) % b.size()].head<2>()));
+    }
+  }
+  return best;
+}
+}  // namespace
+
+void GraspPlanner::plan(SherdDetection& s) const {
+  const double tip = std::max(config_.grasp_height_fraction * s.height, config_.grasp_tip_clearance);
+  s.grasp = Eigen::Isometry3d::Identity();
+  s.grasp.linear() = (Eigen::AngleAxisd(s.yaw, Eigen::Vector3d::UnitZ()) *
+                      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY())).toRotationMatrix();
+  s.grasp.translation() = Eigen::Vector3d(s.centre.x(), s.centre.y(), s.surface + tip + config_.fingertip_offset);
+  s.grasp_width = std::clamp(s.width + config_.grasp_margin, kMinOpening, kMaxOpening);
+}
+
+void GraspPlanner::score(std::vector<SherdDetection>& sherds) const {
+  for (size_t i = 0; i < sherds.size(); ++i) {
+    double gap = 1.0;
+    for (size_t j = 0; j < sherds.size(); ++j) {
+      if (i == j || sherds[i].outline.empty() || sherds[j].outline.empty()) continue;
+      gap = std::min({gap, outlineGap(sherds[i].outline, sherds[j].outline),
+                      outlineGap(sherds[j].outline, sherds[i].outline)});
+    }
+    SherdDetection& s = sherds[i];
+    s.clearance = gap;
+    const double isolation = std::clamp(gap / kFingerWidth, 0.0, 1.0);
+    const double fit = s.width + config_.grasp_margin <= kMaxOpening ? 1.0 : 0.3;
+    const double depth = s.depth_valid ? 1.0 : 0.5;
+    s.score = fit * depth * (0.5 + 0.5 * isolation);
+  }
+}
+
+}  // namespace rascal_perception

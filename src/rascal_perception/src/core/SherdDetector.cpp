@@ -1,0 +1,209 @@
+#include "rascal_perception/SherdDetector.hpp"
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "rascal_perception/SherdSelector.hpp"
+
+namespace rascal_perception {
+
+namespace {
+bool samePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return (a.translation() - b.translation()).norm() < 1e-4 && (a.linear() - b.linear()).norm() < 1e-4;
+}
+}  // namespace
+
+SherdDetector::SherdDetector(const PerceptionConfig& config)
+    : config_(config), measurer_(config), planner_(config) {}
+
+const BackgroundModel* SherdDetector::model(const std::string& station) const {
+  auto it = stations_.find(station);
+  return it == stations_.end() ? nullptr : &it->second.model;
+}
+
+double SherdDetector::pixelsPerMetre(const CameraView& view, double surface_z) const {
+  Eigen::Vector3d p;
+  const CameraIntrinsics& k = view.intrinsics;
+  if (!SherdMeasurer::intersect(view, Eigen::Vector4d(0, 0, 1, -surface_z), 0.0, k.cx, k.cy, p)) {
+    return k.fx / 0.3;
+  }
+  const double z = (view.base_T_camera.inverse() * p).z();
+  return k.fx / std::max(z, 0.01);
+}
+
+cv::Mat SherdDetector::raised(const cv::Mat& depth_mm, const CameraView& view, double surface_z) {
+  if (depth_mm.empty()) return cv::Mat();
+  if ((ray_z_rotation_ - view.base_T_camera.linear()).norm() > 1e-9 || ray_z_.size() != depth_mm.size()) {
+    ray_z_ = SherdMeasurer::rayZMap(view);
+    ray_z_rotation_ = view.base_T_camera.linear();
+  }
+  const float cam_z = static_cast<float>(view.base_T_camera.translation().z() - surface_z);
+  const float min_h = static_cast<float>(config_.min_sherd_height);
+  const uint16_t lo = static_cast<uint16_t>(config_.depth_min * 1000.0);
+  const uint16_t hi = static_cast<uint16_t>(std::min(65535.0, config_.depth_max * 1000.0));
+  cv::Mat out(depth_mm.size(), CV_8U);
+  for (int y = 0; y < depth_mm.rows; ++y) {
+    const uint16_t* d = depth_mm.ptr<uint16_t>(y);
+    const float* r = ray_z_.ptr<float>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < depth_mm.cols; ++x) {
+      o[x] = (d[x] >= lo && d[x] <= hi && cam_z + r[x] * (d[x] * 0.001f) > min_h) ? 255 : 0;
+    }
+  }
+  // a sherd is never thinner than a few pixels: drop isolated noise
+  cv::morphologyEx(out, out, cv::MORPH_OPEN, cv::Mat::ones(3, 3, CV_8U));
+  return out;
+}
+
+CalibrationResult SherdDetector::calibrate(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                                           const CameraView& view, double surface_z) {
+  CalibrationResult r;
+  if (rgb.empty() || rgb.type() != CV_8UC3) {
+    r.message = "no colour image (need rgb8)";
+    return r;
+  }
+  BackgroundOptions o;
+  o.clusters = config_.background_clusters;
+  o.hue_tolerance = config_.hue_tolerance;
+  o.saturation_tolerance = config_.saturation_tolerance;
+  o.min_value = config_.min_value;
+  Station s;
+  try {
+    s.model.learn(rgb, o);
+  } catch (const std::exception& e) {
+    r.message = std::string("station ") + station + ": " + e.what();
+    return r;
+  }
+  s.view = view;
+  s.surface_z = surface_z;
+  s.fixture = s.model.fixtureMask().clone();
+  const cv::Mat up = raised(depth_mm, view, surface_z);
+  if (!up.empty()) s.fixture |= up;  // anything standing on the empty station is a fixture too
+  const int px = static_cast<int>(std::lround(config_.fixture_dilation * pixelsPerMetre(view, surface_z)));
+  if (px > 0) {
+    cv::dilate(s.fixture, s.fixture, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1)));
+  }
+  r.success = true;
+  r.clusters = static_cast<int>(s.model.clusters().size());
+  r.fixture_fraction = static_cast<double>(cv::countNonZero(s.fixture)) / s.fixture.total();
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "station %s: %d background clusters, %.1f %% of the image masked as fixture",
+                station.c_str(), r.clusters, 100.0 * r.fixture_fraction);
+  r.message = buf;
+  stations_[station] = std::move(s);
+  return r;
+}
+
+CalibrationResult SherdDetector::refresh(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                                         const CameraView& view, double surface_z) {
+  CalibrationResult r;
+  auto it = stations_.find(station);
+  if (it == stations_.end()) {
+    r.message = "station " + station + " has no background model: calibrate it first";
+    return r;
+  }
+  cv::Mat fg;
+  segment(station, rgb, depth_mm, view, surface_z, fg);
+  cv::dilate(fg, fg, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
+  fg |= fixture_;
+  it->second.model.refresh(rgb, fg);
+  r.success = true;
+  r.clusters = static_cast<int>(it->second.model.clusters().size());
+  r.fixture_fraction = static_cast<double>(cv::countNonZero(it->second.fixture)) / it->second.fixture.total();
+  r.message = "station " + station + ": background colours refreshed";
+  return r;
+}
+
+void SherdDetector::warpPriors(const Station& s, const CameraView& view, double surface_z, cv::Mat& allowed,
+                               cv::Mat& fixture) const {
+  const cv::Size size(view.intrinsics.width, view.intrinsics.height);
+  if (samePose(s.view.base_T_camera, view.base_T_camera) && s.fixture.size() == size) {
+    allowed = s.model.seenMap();
+    fixture = s.fixture;
+    return;
+  }
+  // pixel of this view -> point on the station plane -> pixel of the calibration view
+  const Eigen::Vector4d plane(0, 0, 1, -surface_z);
+  std::vector<cv::Point2f> here, there;
+  const Eigen::Isometry3d calib_T_base = s.view.base_T_camera.inverse();
+  const float w = static_cast<float>(size.width), h = static_cast<float>(size.height);
+  for (const cv::Point2f& p : {cv::Point2f(0, 0), cv::Point2f(w, 0), cv::Point2f(w, h), cv::Point2f(0, h)}) {
+    Eigen::Vector3d q;
+    if (!SherdMeasurer::intersect(view, plane, 0.0, p.x, p.y, q)) continue;
+    const Eigen::Vector3d c = calib_T_base * q;
+    if (c.z() <= 0) continue;
+    const Eigen::Vector2d uv = s.view.intrinsics.project(c);
+    here.push_back(p);
+    there.emplace_back(static_cast<float>(uv.x()), static_cast<float>(uv.y()));
+  }
+  if (here.size() < 4) {  // the station plane is not under this view: no priors
+    allowed = cv::Mat();
+    fixture = cv::Mat();
+    return;
+  }
+  const cv::Mat H = cv::getPerspectiveTransform(here, there);
+  cv::warpPerspective(s.model.seenMap(), allowed, H, size, cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
+                      cv::BORDER_CONSTANT, cv::Scalar(0xFF));
+  cv::warpPerspective(s.fixture, fixture, H, size, cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                      cv::Scalar(0));
+}
+
+std::vector<Blob> SherdDetector::segment(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                                         const CameraView& view, double surface_z, cv::Mat& foreground,
+                                         SegmentationStats* stats) {
+  const Station& s = stations_.at(station);
+  warpPriors(s, view, surface_z, allowed_, fixture_);
+  const double ppm = pixelsPerMetre(view, surface_z);
+  SegmentationOptions o;
+  o.min_side_px = 0.7 * config_.min_sherd_size * ppm;
+  o.max_side_px = 1.5 * config_.max_sherd_size * ppm;
+  o.border_margin = config_.border_margin;
+  o.split_min_neck = config_.split_min_neck;
+  return segmenter_.segment(rgb, s.model, allowed_, fixture_, raised(depth_mm, view, surface_z), o, foreground,
+                            stats);
+}
+
+DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                                      const CameraView& view, double surface_z) {
+  DetectionResult r;
+  if (!calibrated(station)) {
+    r.message = "station " + station + " has no background model: call calibrate_background first";
+    return r;
+  }
+  if (rgb.empty() || rgb.type() != CV_8UC3) {
+    r.message = "no colour image (need rgb8)";
+    return r;
+  }
+  if (!depth_mm.empty() && (depth_mm.type() != CV_16UC1 || depth_mm.size() != rgb.size())) {
+    r.message = "the depth image must be 16UC1 and the size of the colour image";
+    return r;
+  }
+  cv::Mat foreground;
+  SegmentationStats stats;
+  const std::vector<Blob> blobs = segment(station, rgb, depth_mm, view, surface_z, foreground, &stats);
+  r.rejected_border = stats.rejected_border;
+  r.rejected_size = stats.rejected_size;
+  r.splits = stats.splits;
+  cv::bitwise_not(foreground, usable_);
+  if (!fixture_.empty()) usable_.setTo(0, fixture_);
+  const PlaneFit plane = depth_mm.empty() ? PlaneFit() : measurer_.fitPlane(depth_mm, usable_, view, surface_z);
+  r.plane = plane.ok ? plane.plane : Eigen::Vector4d(0, 0, 1, -surface_z);
+  r.plane_inliers = plane.inliers;
+  for (const Blob& b : blobs) {
+    SherdDetection d;
+    std::string why;
+    if (!measurer_.measure(b, rgb, depth_mm, view, r.plane, d, why)) {
+      ++r.rejected_size;
+      continue;
+    }
+    planner_.plan(d);
+    r.sherds.push_back(std::move(d));
+  }
+  planner_.score(r.sherds);
+  SherdSelector::order(r.sherds, config_.selection_policy, view.base_T_camera.translation().head<2>());
+  r.success = true;
+  r.message = "station " + station + ": " + std::to_string(r.sherds.size()) + " sherds";
+  return r;
+}
+
+}  // namespace rascal_perception

@@ -1,0 +1,74 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rascal_perception/GraspPlanner.hpp"
+#include "rascal_perception/SherdSelector.hpp"
+
+using namespace rascal_perception;
+
+namespace {
+SherdDetection sherd(double x, double y, double yaw, double length, double width, double height) {
+  SherdDetection s;
+  s.centre = Eigen::Vector3d(x, y, height);
+  s.yaw = yaw;
+  s.length = length;
+  s.width = width;
+  s.height = height;
+  s.area = length * width;
+  s.depth_valid = true;
+  const Eigen::Rotation2Dd r(yaw);
+  for (const auto& c : {Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1), Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1)}) {
+    const Eigen::Vector2d p = Eigen::Vector2d(x, y) + r * Eigen::Vector2d(c.x() * length / 2, c.y() * width / 2);
+    s.outline.emplace_back(p.x(), p.y(), 0.0);
+  }
+  return s;
+}
+}  // namespace
+
+TEST(GraspPlanner, FingersCloseAcrossTheMinorAxisPointingDown) {
+  PerceptionConfig c;
+  SherdDetection s = sherd(0.2, 0.25, 0.7, 0.06, 0.04, 0.010);
+  GraspPlanner(c).plan(s);
+  const Eigen::Matrix3d R = s.grasp.linear();
+  EXPECT_NEAR(R.col(0).z(), -1.0, 1e-9);  // approach: gripper x straight down
+  const Eigen::Vector2d minor(-std::sin(0.7), std::cos(0.7));
+  EXPECT_NEAR(std::fabs(R.col(1).head<2>().dot(minor)), 1.0, 1e-9);  // closing along y = minor axis
+  EXPECT_NEAR(s.grasp.translation().z(), 0.6 * 0.010 + c.fingertip_offset, 1e-9);
+  EXPECT_NEAR(s.grasp_width, 0.04 + c.grasp_margin, 1e-12);
+}
+
+TEST(GraspPlanner, ClampsTheHeightAndTheOpening) {
+  PerceptionConfig c;
+  SherdDetection thin = sherd(0.2, 0.25, 0.0, 0.05, 0.010, 0.004);
+  GraspPlanner(c).plan(thin);
+  EXPECT_NEAR(thin.grasp.translation().z(), c.grasp_tip_clearance + c.fingertip_offset, 1e-9);
+  EXPECT_DOUBLE_EQ(thin.grasp_width, GraspPlanner::kMinOpening);
+  SherdDetection wide = sherd(0.2, 0.25, 0.0, 0.09, 0.07, 0.01);
+  GraspPlanner(c).plan(wide);
+  EXPECT_DOUBLE_EQ(wide.grasp_width, GraspPlanner::kMaxOpening);
+}
+
+TEST(GraspPlanner, ScoresCrowdedSherdsLower) {
+  PerceptionConfig c;
+  std::vector<SherdDetection> v{sherd(0.10, 0.25, 0, 0.05, 0.04, 0.01), sherd(0.155, 0.25, 0, 0.05, 0.04, 0.01),
+                                sherd(0.30, 0.25, 0, 0.05, 0.04, 0.01)};
+  GraspPlanner(c).score(v);
+  EXPECT_NEAR(v[0].clearance, 0.005, 1e-9);
+  EXPECT_LT(v[0].score, v[2].score);
+  EXPECT_NEAR(v[2].score, 1.0, 1e-9);
+}
+
+TEST(SherdSelector, OrdersByPolicy) {
+  std::vector<SherdDetection> v{sherd(0.30, 0.25, 0, 0.05, 0.04, 0.01), sherd(0.10, 0.25, 0, 0.07, 0.05, 0.01),
+                                sherd(0.16, 0.25, 0, 0.04, 0.035, 0.01)};
+  GraspPlanner(PerceptionConfig()).score(v);
+  SherdSelector::order(v, SelectionPolicy::kNearest, Eigen::Vector2d(0.15, 0.25));
+  EXPECT_NEAR(v[0].centre.x(), 0.16, 1e-12);
+  SherdSelector::order(v, SelectionPolicy::kLargest, Eigen::Vector2d::Zero());
+  EXPECT_NEAR(v[0].centre.x(), 0.10, 1e-12);
+  SherdSelector::order(v, SelectionPolicy::kMostIsolated, Eigen::Vector2d::Zero());
+  EXPECT_NEAR(v[0].centre.x(), 0.30, 1e-12);
+  EXPECT_THROW(parseSelectionPolicy("random"), std::invalid_argument);
+  EXPECT_EQ(parseSelectionPolicy("most_isolated"), SelectionPolicy::kMostIsolated);
+}

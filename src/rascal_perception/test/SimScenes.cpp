@@ -1,0 +1,170 @@
+#include "SimScenes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "rascal_sim/MunsellTable.hpp"
+#include "rascal_sim/ScenarioGenerator.hpp"
+#include "rascal_sim/ScenarioLoader.hpp"
+#include "rascal_sim/Simulator.hpp"
+
+using namespace rascal_sim;
+
+namespace rascal_perception_test {
+
+const WorldLayout& layout() {
+  static const WorldLayout l = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
+  return l;
+}
+
+static const MunsellTable& munsell() {
+  static const MunsellTable m(std::string(RASCAL_SIM_DATA_DIR) + "/munsell_soil_hues_grid_renotation.csv");
+  return m;
+}
+
+JointVector pointDown(double x, double y, double z) {
+  const double waist = std::atan2(y, x), r = std::hypot(x, y);
+  JointVector best{};
+  double best_err = 1e9, step = 0.02, sh0 = -1.8, sh1 = 1.9, el0 = -2.1, el1 = 1.6;
+  for (int pass = 0; pass < 4; ++pass) {
+    for (double sh = sh0; sh <= sh1; sh += step) {
+      for (double el = el0; el <= el1; el += step) {
+        const JointVector q{waist, sh, el, 0, M_PI / 2 - sh - el, 0};
+        if (q[4] < ArmKinematics::lowerLimits()[4] || q[4] > ArmKinematics::upperLimits()[4]) continue;
+        const Eigen::Vector3d p = ArmKinematics::forward(q, 0.037)[kEeGripperLink].translation();
+        const double err = std::hypot(std::hypot(p.x(), p.y()) - r, p.z() - z);
+        if (err < best_err) {
+          best_err = err;
+          best = q;
+        }
+      }
+    }
+    sh0 = best[1] - 2 * step, sh1 = best[1] + 2 * step, el0 = best[2] - 2 * step, el1 = best[2] + 2 * step;
+    step /= 5;
+  }
+  return best;
+}
+
+const JointVector& surveyJoints() {
+  // camera over the mat's centre, image rows along the mat: wrist_rotate undoes the waist, and the
+  // gripper goes where the camera's offset from it puts the camera over the centre
+  static const JointVector q = [] {
+    const Eigen::Vector2d goal = layout().pickup.position;
+    Eigen::Vector2d target = goal;
+    JointVector j{};
+    for (int i = 0; i < 3; ++i) {
+      j = pointDown(target.x(), target.y(), 0.25);
+      j[5] = -j[0];
+      const auto T = ArmKinematics::forward(j, 0.037);
+      target += goal - T[kCameraColorOpticalFrame].translation().head<2>();
+    }
+    return j;
+  }();
+  return q;
+}
+
+Frame render(const Scenario& scenario, const JointVector& q) {
+  SimulatorOptions o;
+  o.initial_joints = q;
+  o.archival_width = 64;
+  o.archival_height = 48;
+  Simulator sim(layout(), o);
+  sim.load(scenario);
+  WristFrame w = sim.renderWristFrame();
+  Frame f;
+  f.rgb = w.rgb;
+  f.depth = w.depth_mm;
+  const CameraModel& m = sim.wristModel();
+  f.view.intrinsics = {m.width, m.height, m.fx, m.fy, m.cx, m.cy};
+  f.view.base_T_camera = w.world_T_camera;
+  for (const SherdState& s : sim.groundTruth()) {
+    Truth t;
+    t.name = s.name;
+    t.centre = s.pose.translation().head<2>();
+    const Eigen::Vector3d x = s.pose.linear().col(0);
+    t.yaw = std::atan2(x.y(), x.x());
+    t.length = s.length;
+    t.width = s.width;
+    t.top = s.pose.translation().z() + 0.5 * s.box_size.z();
+    std::vector<cv::Point2f> poly;
+    for (const Eigen::Vector2d& p : s.outline) {
+      const Eigen::Vector3d w = s.pose * Eigen::Vector3d(p.x(), p.y(), 0.0);
+      t.outline.push_back(w.head<2>());
+      poly.emplace_back(static_cast<float>(w.x() * 1e3), static_cast<float>(w.y() * 1e3));
+    }
+    if (poly.size() >= 3) {
+      const cv::Moments m = cv::moments(poly);
+      t.principal_yaw = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
+    }
+    f.truth.push_back(t);
+  }
+  return f;
+}
+
+void Truth::extents(double yaw, double& l, double& w, Eigen::Vector2d& c) const {
+  const Eigen::Vector2d a(std::cos(yaw), std::sin(yaw)), b(-std::sin(yaw), std::cos(yaw));
+  double u0 = 1e9, u1 = -1e9, v0 = 1e9, v1 = -1e9;
+  for (const Eigen::Vector2d& p : outline) {
+    u0 = std::min(u0, a.dot(p)), u1 = std::max(u1, a.dot(p)), v0 = std::min(v0, b.dot(p)), v1 = std::max(v1, b.dot(p));
+  }
+  l = u1 - u0;
+  w = v1 - v0;
+  c = 0.5 * (u0 + u1) * a + 0.5 * (v0 + v1) * b;
+}
+
+Scenario generated(unsigned seed, int count, double brightness, double kelvin, double shadow, int touching_pairs) {
+  Scenario sc;
+  sc.name = "generated_" + std::to_string(seed);
+  sc.seed = seed;
+  sc.lighting.brightness = brightness;
+  sc.lighting.colour_temperature = kelvin;
+  sc.lighting.shadow_strength = shadow;
+  sc.lighting.shadow_radius = 0.07;
+  sc.lighting.shadow_start = layout().pickup.position + Eigen::Vector2d(0.02 * (seed % 5) - 0.04, 0.0);
+  GeneratorOptions g;
+  g.count = count;
+  g.seed = seed;
+  g.area = layout().pickup;
+  g.touching_pairs = touching_pairs;
+  sc.sherds = ScenarioGenerator(munsell()).generate(g);
+  return sc;
+}
+
+namespace {
+std::vector<Eigen::Vector2d> placed(const SherdSpec& s) {
+  const Eigen::Rotation2Dd r(s.pose.z());
+  std::vector<Eigen::Vector2d> out;
+  for (const Eigen::Vector2d& p : s.outline) out.push_back(s.pose.head<2>() + r * p);
+  return out;
+}
+
+double gap(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
+  double best = 1e9;
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto& p = pass ? b : a;
+    const auto& q = pass ? a : b;
+    for (const Eigen::Vector2d& v : p) {
+      for (size_t k = 0; k < q.size(); ++k) {
+        const Eigen::Vector2d s0 = q[k], s1 = q[(k + 1) % q.size()];
+        const double t = std::clamp((v - s0).dot(s1 - s0) / (s1 - s0).squaredNorm(), 0.0, 1.0);
+        best = std::min(best, (s0 + t * (s1 - s0) - v).norm());
+      }
+    }
+  }
+  return best;
+}
+}  // namespace
+
+void makeTouching(Scenario& sc, size_t i, size_t j) {
+  SherdSpec& b = sc.sherds[j];
+  const Eigen::Vector2d dir = (sc.sherds[i].pose.head<2>() - b.pose.head<2>()).normalized();
+  const auto a = placed(sc.sherds[i]);
+  for (int k = 0; k < 1000 && gap(a, placed(b)) > 0.0003; ++k) b.pose.head<2>() += 0.0002 * dir;
+}
+
+Scenario loadScenario(const std::string& file) {
+  return ScenarioLoader(layout(), munsell()).load(std::string(RASCAL_PERCEPTION_SCENARIOS) + "/" + file);
+}
+
+}  // namespace rascal_perception_test

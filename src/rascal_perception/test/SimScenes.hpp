@@ -1,0 +1,45 @@
+#pragma once
+// Test helper: wrist RGB-D frames of simulator scenarios (rascal_sim_core), with ground truth.
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "rascal_perception/SherdMeasurer.hpp"
+#include "rascal_sim/ArmKinematics.hpp"
+#include "rascal_sim/Scenario.hpp"
+#include "rascal_sim/WorldLayout.hpp"
+
+namespace rascal_perception_test {
+
+struct Truth {
+  std::string name;
+  Eigen::Vector2d centre;
+  double yaw = 0.0, length = 0.0, width = 0.0, top = 0.0;  ///< top: z of the box top
+  std::vector<Eigen::Vector2d> outline;  ///< true outline in base_link (x, y)
+  double principal_yaw = 0.0;            ///< major axis of the outline's area moments
+  /// Extents of the true outline along `yaw` and across it, and the centre of that box.
+  void extents(double yaw, double& length, double& width, Eigen::Vector2d& centre) const;
+};
+
+struct Frame {
+  cv::Mat rgb, depth;
+  rascal_perception::CameraView view;
+  std::vector<Truth> truth;
+};
+
+const rascal_sim::WorldLayout& layout();
+/// Joints putting ee_gripper_link at (x, y, z) pointing straight down.
+rascal_sim::JointVector pointDown(double x, double y, double z);
+/// Survey joints over the pickup mat (computed once).
+const rascal_sim::JointVector& surveyJoints();
+/// Renders one wrist frame of `scenario` at joints q (no physics steps: sherds rest where spawned).
+Frame render(const rascal_sim::Scenario& scenario, const rascal_sim::JointVector& q);
+/// A generated scenario on the pickup mat.
+rascal_sim::Scenario generated(unsigned seed, int count, double brightness, double kelvin, double shadow,
+                               int touching_pairs = 0);
+/// Slides sherd j towards sherd i until their outlines touch (within 0.3 mm).
+void makeTouching(rascal_sim::Scenario& scenario, size_t i, size_t j);
+rascal_sim::Scenario loadScenario(const std::string& file);
+
+}  // namespace rascal_perception_test
