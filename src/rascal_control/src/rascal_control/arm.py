@@ -53,11 +53,12 @@ class Arm:
 
     def __init__(self, move_client=None, ik_service=None, fk_service=None, wait: float = 10.0):
         if move_client is None:
-            import actionlib
             import rospy
             from rascal_msgs.msg import MoveArmAction
             from rascal_msgs.srv import ComputeFK, ComputeIK
-            move_client = actionlib.SimpleActionClient("/rascal/arm/move", MoveArmAction)
+
+            from rascal_control.goal_runner import GoalRunner
+            move_client = GoalRunner("/rascal/arm/move", MoveArmAction)
             if not move_client.wait_for_server(rospy.Duration(wait)):
                 raise Timeout(3, "no /rascal/arm/move action server within %.0f s; is "
                                  "arm_controller running?" % wait)

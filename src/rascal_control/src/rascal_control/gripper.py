@@ -13,10 +13,11 @@ class Gripper:
 
     def __init__(self, client=None, wait: float = 10.0):
         if client is None:
-            import actionlib
             import rospy
             from rascal_msgs.msg import GripperAction
-            client = actionlib.SimpleActionClient("/rascal/gripper", GripperAction)
+
+            from rascal_control.goal_runner import GoalRunner
+            client = GoalRunner("/rascal/gripper", GripperAction)
             if not client.wait_for_server(rospy.Duration(wait)):
                 raise Timeout(3, "no /rascal/gripper action server within %.0f s; is "
                                  "arm_controller running?" % wait)
