@@ -15,7 +15,7 @@ struct GeneratorOptions {
   int count = 10;
   unsigned seed = 1;
   TableRect area;                    ///< where the sherds go (normally the pickup mat)
-  double min_spacing = 0.012;        ///< [m] gap between neighbouring sherds (a finger's width)
+  double min_spacing = 0.016;        ///< [m] gap between neighbours: a finger (8 mm) and the grasp margin
   int touching_pairs = 0;            ///< pairs of sherds pushed together until they touch
   double length_min = 0.035, length_max = 0.070;  ///< [m] outline major axis
   double width_min = 0.032, width_max = 0.050;    ///< [m] outline minor axis (>= 30 mm gripper)
