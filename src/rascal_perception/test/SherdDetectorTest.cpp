@@ -241,3 +241,4 @@ TEST(SherdDetector, BackgroundCalibratedInDimLightWorksInBrightLight) {
     }
   }
 }
+TEST(Print, SurveyJoints) { const auto& q = rascal_perception_test::surveyJoints(); std::printf("survey joints: %.4f %.4f %.4f %.4f %.4f %.4f\n", q[0], q[1], q[2], q[3], q[4], q[5]); }

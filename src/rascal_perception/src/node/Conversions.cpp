@@ -1,0 +1,197 @@
+#include "Conversions.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace rascal_perception {
+namespace conversions {
+
+namespace {
+cv::Mat wrap(const sensor_msgs::Image& msg, int type, size_t pixel_bytes) {
+  if (msg.step < msg.width * pixel_bytes || msg.data.size() < static_cast<size_t>(msg.step) * msg.height) {
+    throw std::invalid_argument("image data shorter than width x height");
+  }
+  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
+                 const_cast<uint8_t*>(msg.data.data()), msg.step);
+}
+}  // namespace
+
+cv::Mat colourImage(const sensor_msgs::Image& msg) {
+  cv::Mat out;
+  if (msg.encoding == "rgb8") {
+    wrap(msg, CV_8UC3, 3).copyTo(out);
+  } else if (msg.encoding == "bgr8") {
+    cv::cvtColor(wrap(msg, CV_8UC3, 3), out, cv::COLOR_BGR2RGB);
+  } else {
+    throw std::invalid_argument("colour encoding '" + msg.encoding + "' (need rgb8 or bgr8)");
+  }
+  return out;
+}
+
+cv::Mat depthImage(const sensor_msgs::Image& msg) {
+  cv::Mat out;
+  if (msg.encoding == "16UC1" || msg.encoding == "mono16") {
+    wrap(msg, CV_16UC1, 2).copyTo(out);
+  } else if (msg.encoding == "32FC1") {
+    wrap(msg, CV_32FC1, 4).convertTo(out, CV_16UC1, 1000.0);
+  } else {
+    throw std::invalid_argument("depth encoding '" + msg.encoding + "' (need 16UC1 mm or 32FC1 m)");
+  }
+  return out;
+}
+
+sensor_msgs::Image toImage(const cv::Mat& rgb, const std_msgs::Header& header) {
+  sensor_msgs::Image m;
+  m.header = header;
+  m.height = rgb.rows;
+  m.width = rgb.cols;
+  m.encoding = "rgb8";
+  m.step = rgb.cols * 3;
+  m.data.resize(static_cast<size_t>(m.step) * m.height);
+  for (int y = 0; y < rgb.rows; ++y) std::memcpy(&m.data[static_cast<size_t>(y) * m.step], rgb.ptr(y), m.step);
+  return m;
+}
+
+CameraIntrinsics intrinsics(const sensor_msgs::CameraInfo& info) {
+  CameraIntrinsics k;
+  k.width = static_cast<int>(info.width);
+  k.height = static_cast<int>(info.height);
+  k.fx = info.K[0];
+  k.fy = info.K[4];
+  k.cx = info.K[2];
+  k.cy = info.K[5];
+  if (k.fx <= 0 || k.fy <= 0) throw std::invalid_argument("camera_info has no focal length (K[0], K[4])");
+  return k;
+}
+
+Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
+  Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
+  e.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  e.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).normalized().toRotationMatrix();
+  return e;
+}
+
+geometry_msgs::Pose toPose(const Eigen::Isometry3d& pose) {
+  geometry_msgs::Pose p;
+  p.position.x = pose.translation().x();
+  p.position.y = pose.translation().y();
+  p.position.z = pose.translation().z();
+  const Eigen::Quaterniond q(pose.linear());
+  p.orientation.w = q.w();
+  p.orientation.x = q.x();
+  p.orientation.y = q.y();
+  p.orientation.z = q.z();
+  return p;
+}
+
+rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& header, uint32_t id) {
+  rascal_msgs::Sherd s;
+  s.header = header;
+  s.id = id;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = d.centre;
+  pose.linear() = Eigen::AngleAxisd(d.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  s.pose = toPose(pose);
+  s.length = d.length;
+  s.width = d.width;
+  s.height = d.height;
+  s.area = d.area;
+  s.color.r = static_cast<float>(d.colour.x());
+  s.color.g = static_cast<float>(d.colour.y());
+  s.color.b = static_cast<float>(d.colour.z());
+  s.color.a = 1.0f;
+  s.grasp_pose = toPose(d.grasp);
+  s.grasp_width = d.grasp_width;
+  s.score = d.score;
+  for (int i = 0; i < 5; ++i) s.image_box[i] = d.image_box[i];
+  for (const Eigen::Vector3d& p : d.outline) {
+    geometry_msgs::Point q;
+    q.x = p.x();
+    q.y = p.y();
+    q.z = p.z();
+    s.outline.push_back(q);
+  }
+  return s;
+}
+
+visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherds, const std_msgs::Header& header) {
+  visualization_msgs::MarkerArray a;
+  visualization_msgs::Marker clear;
+  clear.header = header;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  a.markers.push_back(clear);
+  for (size_t i = 0; i < sherds.size(); ++i) {
+    const SherdDetection& d = sherds[i];
+    visualization_msgs::Marker box;
+    box.header = header;
+    box.ns = "sherds";
+    box.id = static_cast<int>(i);
+    box.type = visualization_msgs::Marker::CUBE;
+    box.action = visualization_msgs::Marker::ADD;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    const double h = std::max(d.height, 0.002);
+    pose.translation() = Eigen::Vector3d(d.centre.x(), d.centre.y(), d.surface + 0.5 * h);
+    pose.linear() = Eigen::AngleAxisd(d.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    box.pose = toPose(pose);
+    box.scale.x = d.length;
+    box.scale.y = d.width;
+    box.scale.z = h;
+    box.color.r = i == 0 ? 1.0f : 0.2f;
+    box.color.g = i == 0 ? 0.3f : 0.9f;
+    box.color.b = 0.2f;
+    box.color.a = 0.5f;
+    a.markers.push_back(box);
+
+    visualization_msgs::Marker arrow = box;
+    arrow.ns = "grasps";
+    arrow.type = visualization_msgs::Marker::ARROW;
+    arrow.pose = geometry_msgs::Pose();
+    arrow.pose.orientation.w = 1.0;
+    geometry_msgs::Point from, to;
+    to.x = d.grasp.translation().x();
+    to.y = d.grasp.translation().y();
+    to.z = d.grasp.translation().z();
+    from = to;
+    from.z += 0.06;
+    arrow.points = {from, to};
+    arrow.scale.x = 0.004;
+    arrow.scale.y = 0.008;
+    arrow.scale.z = 0.01;
+    arrow.color.r = 1.0f;
+    arrow.color.g = 0.0f;
+    arrow.color.b = 1.0f;
+    arrow.color.a = 1.0f;
+    a.markers.push_back(arrow);
+
+    visualization_msgs::Marker fingers = arrow;  // the closing direction, across the minor axis
+    fingers.ns = "fingers";
+    fingers.type = visualization_msgs::Marker::LINE_LIST;
+    const Eigen::Vector3d across = d.grasp.linear().col(1) * (0.5 * d.grasp_width);
+    geometry_msgs::Point l = to, r = to;
+    l.x += across.x(), l.y += across.y();
+    r.x -= across.x(), r.y -= across.y();
+    fingers.points = {l, r};
+    fingers.scale.x = 0.002;
+    a.markers.push_back(fingers);
+
+    visualization_msgs::Marker text = box;
+    text.ns = "labels";
+    text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+    text.pose.position.z = d.centre.z() + 0.02;
+    text.pose.orientation = geometry_msgs::Quaternion();
+    text.pose.orientation.w = 1.0;
+    text.scale.z = 0.012;
+    text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "#%zu %.0fx%.0fx%.0f mm", i, d.length * 1e3, d.width * 1e3, d.height * 1e3);
+    text.text = buf;
+    a.markers.push_back(text);
+  }
+  return a;
+}
+
+}  // namespace conversions
+}  // namespace rascal_perception

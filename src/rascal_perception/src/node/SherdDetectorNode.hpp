@@ -1,0 +1,61 @@
+#pragma once
+// ROS wrapper of the perception core: parameters, camera subscriptions, TF, the detect and
+// calibrate_background services, markers and the annotated image.
+#include <ros/ros.h>
+#include <rascal_msgs/CalibrateBackground.h>
+#include <rascal_msgs/Detect.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "rascal_perception/SherdDetector.hpp"
+
+namespace rascal_perception {
+
+class SherdDetectorNode {
+ public:
+  /// Reads and checks every parameter (throws std::runtime_error naming the key), then
+  /// subscribes, serves and advertises.
+  SherdDetectorNode(ros::NodeHandle& root, ros::NodeHandle& private_nh);
+
+ private:
+  struct Frame {
+    sensor_msgs::ImageConstPtr colour, depth;
+  };
+  void readParameters(ros::NodeHandle& root);
+  void onColour(const sensor_msgs::ImageConstPtr& msg);
+  void onDepth(const sensor_msgs::ImageConstPtr& msg);
+  void onInfo(const sensor_msgs::CameraInfoConstPtr& msg);
+  bool onDetect(rascal_msgs::Detect::Request& req, rascal_msgs::Detect::Response& res);
+  bool onCalibrate(rascal_msgs::CalibrateBackground::Request& req, rascal_msgs::CalibrateBackground::Response& res);
+  /// The first colour + depth pair stamped at or after `since` (waits up to wait_s of ROS time).
+  bool waitForFrame(const ros::Time& since, Frame& frame, std::string& why);
+  /// Images, intrinsics and base_link <- optical frame of a pair.
+  bool prepare(const Frame& frame, cv::Mat& rgb, cv::Mat& depth, CameraView& view, std::string& why);
+
+  PerceptionConfig config_;
+  std::map<std::string, double> surfaces_;  ///< station -> surface_z
+  double wait_s_ = 1.0;
+  std::string base_frame_ = "base_link";
+
+  std::mutex mutex_;  ///< guards the frame buffers and camera info
+  std::deque<sensor_msgs::ImageConstPtr> colours_, depths_;
+  sensor_msgs::CameraInfoConstPtr info_;
+  std::mutex detector_mutex_;  ///< one service call at a time uses the detector
+  std::unique_ptr<SherdDetector> detector_;
+
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  ros::Subscriber colour_sub_, depth_sub_, info_sub_;
+  ros::ServiceServer detect_srv_, calibrate_srv_;
+  ros::Publisher markers_pub_, annotated_pub_;
+};
+
+}  // namespace rascal_perception
