@@ -131,8 +131,7 @@ def test_detects_the_demo_sherds_in_base_link(ros_master, rosrun):
     ros_master.run(["rosparam", "load", CONFIG])
     ros_master.run(["rosparam", "set", "/use_sim_time", "true"])
     ros_master.run(["rosparam", "set", "/simulator/real_time_factor", "1.0"])
-    with open(URDF) as f:
-        ros_master.run(["rosparam", "set", "/robot_description", f.read()])
+    ros_master.run(["rosparam", "set", "--textfile", URDF, "/robot_description"])
     rosrun("rascal_sim", "sim")
     wait_for(ros_master, "topic", "/joint_states")
     rosrun("robot_state_publisher", "robot_state_publisher")
