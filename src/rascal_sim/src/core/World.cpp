@@ -320,6 +320,7 @@ void World::clearSherds() {
 }
 
 void World::spawn(const std::vector<SherdSpec>& sherds) {
+  dAllocateODEDataForThread(dAllocateMaskAll);  // spawn may come from a service thread
   clearSherds();
   Impl& w = *impl_;
   for (size_t i = 0; i < sherds.size(); ++i) {
