@@ -107,3 +107,35 @@ TEST(ScenarioLoader, ShippedScenariosLoad) {
   EXPECT_FALSE(small.sherds[2].mesh_file.empty());
   for (const auto& s : demo.sherds) EXPECT_NO_THROW(SherdMeshBuilder::build(s)) << s.name;
 }
+
+TEST(ScenarioLoader, TouchingPairsMeet) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  const Scenario s = loader.parse("seed: 5\ngenerate: {count: 10, touching_pairs: 2}\n");
+  ASSERT_EQ(s.sherds.size(), 10u);
+  // the collision boxes of each pair are 0.2 mm apart: check on a fine grid of box points
+  auto minDistance = [](const SherdSpec& a, const SherdSpec& b) {
+    const SherdGeometry ga = SherdMeshBuilder::build(a), gb = SherdMeshBuilder::build(b);
+    auto points = [](const SherdSpec& s, const SherdGeometry& g) {
+      std::vector<Eigen::Vector2d> p;
+      const Eigen::Rotation2Dd r(s.pose.z());
+      for (int i = 0; i <= 100; ++i) {
+        const double t = i / 100.0 - 0.5;
+        const double hx = g.box_size.x() / 2, hy = g.box_size.y() / 2;
+        for (const Eigen::Vector2d& q : {Eigen::Vector2d(t * 2 * hx, -hy), Eigen::Vector2d(t * 2 * hx, hy),
+                                         Eigen::Vector2d(-hx, t * 2 * hy), Eigen::Vector2d(hx, t * 2 * hy)}) {
+          p.push_back(r * q + s.pose.head<2>());
+        }
+      }
+      return p;
+    };
+    double d = 1e9;
+    for (const auto& p : points(a, ga)) {
+      for (const auto& q : points(b, gb)) d = std::min(d, (p - q).norm());
+    }
+    return d;
+  };
+  EXPECT_LT(minDistance(s.sherds[0], s.sherds[1]), 0.001);
+  EXPECT_LT(minDistance(s.sherds[2], s.sherds[3]), 0.001);
+  EXPECT_GT(minDistance(s.sherds[4], s.sherds[5]), 0.015);  // the third pair stays apart
+}

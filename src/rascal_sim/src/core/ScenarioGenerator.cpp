@@ -15,6 +15,21 @@ double uniform(std::mt19937& rng, double a, double b) {
   return std::uniform_real_distribution<double>(a, b)(rng);
 }
 
+/// Gap between two turned boxes (centre x, y, yaw; half sizes) along the best separating axis;
+/// negative when they overlap.
+double boxGap(const Eigen::Vector3d& a, const Eigen::Vector2d& ha, const Eigen::Vector3d& b, const Eigen::Vector2d& hb) {
+  const Eigen::Vector2d axes[4] = {{std::cos(a.z()), std::sin(a.z())}, {-std::sin(a.z()), std::cos(a.z())},
+                                   {std::cos(b.z()), std::sin(b.z())}, {-std::sin(b.z()), std::cos(b.z())}};
+  const Eigen::Vector2d d = b.head<2>() - a.head<2>();
+  double gap = -1e9;
+  for (const auto& n : axes) {
+    const double ra = ha.x() * std::abs(n.dot(axes[0])) + ha.y() * std::abs(n.dot(axes[1]));
+    const double rb = hb.x() * std::abs(n.dot(axes[2])) + hb.y() * std::abs(n.dot(axes[3]));
+    gap = std::max(gap, std::abs(n.dot(d)) - ra - rb);
+  }
+  return gap;
+}
+
 /// Extents along x and y of a length x width box turned by yaw.
 Eigen::Vector2d turnedExtents(double length, double width, double yaw) {
   const double c = std::abs(std::cos(yaw)), s = std::abs(std::sin(yaw));
@@ -81,7 +96,7 @@ std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) co
   }
   if (chips.empty()) chips.push_back(munsell_.notations().front());
 
-  std::vector<Eigen::Vector2d> lo(o.count), hi(o.count);
+  std::vector<Eigen::Vector2d> extents(o.count);  // outline length and width of each sherd
   for (int i = 0; i < o.count; ++i) {
     SherdSpec s;
     char name[32];
@@ -129,17 +144,25 @@ std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) co
     centre.x() += uniform(rng, -slack.x() / 2, slack.x() / 2 + 1e-12);
     centre.y() += uniform(rng, -slack.y() / 2, slack.y() / 2 + 1e-12);
     s.pose = Eigen::Vector3d(centre.x(), centre.y(), std::remainder(yaw, 2 * kPi));
-    lo[i] = centre - ext / 2;
-    hi[i] = centre + ext / 2;
+    extents[i] = Eigen::Vector2d(length, width);
     out.push_back(s);
   }
-  // touching pairs: neighbours in a row pushed together along x until their boxes meet
+  // touching pairs: neighbours in a row pushed together along x until their (collision) boxes
+  // are 0.2 mm apart
   int pairs = 0;
   for (int i = 0; i + 1 < o.count && pairs < o.touching_pairs; i += 2) {
     if (i / cols != (i + 1) / cols) continue;
-    const double gap = lo[i + 1].x() - hi[i].x();
-    out[i].pose.x() += gap / 2;
-    out[i + 1].pose.x() -= gap / 2;
+    const Eigen::Vector2d ha = extents[i] / 2, hb = extents[i + 1] / 2;
+    double lo_s = 0.0, hi_s = out[i + 1].pose.x() - out[i].pose.x();
+    for (int k = 0; k < 60; ++k) {
+      const double mid = (lo_s + hi_s) / 2;
+      Eigen::Vector3d a = out[i].pose, b = out[i + 1].pose;
+      a.x() += mid / 2;
+      b.x() -= mid / 2;
+      (boxGap(a, ha, b, hb) > 0.0002 ? lo_s : hi_s) = mid;
+    }
+    out[i].pose.x() += lo_s / 2;
+    out[i + 1].pose.x() -= lo_s / 2;
     ++pairs;
   }
   return out;
