@@ -61,7 +61,7 @@ BAD = [
     ("arm.standby", [0.30, -0.30], "arm.standby: inside the archival camera's view"),
     ("arm.named_poses.home", [0, 0, 0], "arm.named_poses.home: expected 6 joint angles"),
     ("arm.named_poses.sleep", _DELETE, "arm.named_poses.sleep: missing"),
-    ("survey.z", 0.10, "survey.z: expected at least arm.travel_z"),
+    ("arm.travel_z", 0.26, "survey.z: expected at least arm.travel_z (0.26 m)"),
     ("survey.z", 0.45, "survey.z: too high to reach the survey pose"),
     ("survey.step", 0, "survey.step: expected a number in metres in [0.02, 0.5], got 0"),
     ("perception.selection_policy", "random", "perception.selection_policy: expected one of nearest"),

@@ -58,10 +58,11 @@ class Recorder:
         return self.archive.path(self.catalogue.get(rec["sherd_id"])["image_path"])
 
     def done(self, seq, seconds: float = None, timings: dict = None):
-        self.catalogue.record_done(self._id(seq), t_discard_s=seconds, timings=timings)
+        self.catalogue.record_done(self._id(seq), t_discard_s=seconds, timings=timings,
+                                   archive=self.archive)
 
-    def lost(self, seq, reason: str):
-        self.catalogue.record_lost(self._id(seq), reason)
+    def lost(self, seq, reason: str, timings: dict = None):
+        self.catalogue.record_lost(self._id(seq), reason, timings=timings)
 
     def drop(self, seq, station: str):
         self.catalogue.record_drop(self._id(seq), station)

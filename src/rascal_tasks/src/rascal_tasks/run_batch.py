@@ -118,6 +118,9 @@ def print_summary(batch, recorder, outcome, wall_seconds):
     print("batch %s: %s — %d recorded, %d lost, %.1f s (%s), wall %.1f s" % (
         batch.context, outcome, batch.completed, batch.lost, sim,
         "%.1f s/sherd" % (sim / n) if n else "no sherds", wall_seconds))
+    if batch.state_times:
+        print("time per state (s): " + ", ".join(
+            "%s %.1f" % kv for kv in sorted(batch.state_times.items(), key=lambda kv: -kv[1])))
     print("%4s  %-13s %9s %9s %9s %9s %6s  %s" % ("seq", "status", "mass g", "length mm",
                                                   "width mm", "thick mm", "drops", "image"))
     for r in rows:

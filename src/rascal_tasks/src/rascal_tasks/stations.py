@@ -5,6 +5,7 @@ builds its states from the config's station list, so a new kind of station (a pr
 a second camera) is a new class here plus a config entry, not an edit of the state machine.
 No ROS here: plug-ins use the rig interfaces (`rig.py`) and the batch's recorder.
 """
+import math
 from typing import Dict, Type
 
 from rascal_tasks.rig import RigError
@@ -30,6 +31,9 @@ class StationPlugin:
     status = ""
     # True: the sherd is released from travel height and never picked up again (discard box).
     release_from_above = False
+    # True: after placing, the gripper waits just above the sherd (nothing to keep out of view),
+    # so picking it up again is a short descent instead of a trip from travel height.
+    hover_after_place = False
 
     def __init__(self, station, batch):
         self.station = station  # rascal_tasks.config.Station
@@ -48,6 +52,7 @@ class StationPlugin:
 @station_type("scale")
 class ScaleStation(StationPlugin):
     status = "weighed"
+    hover_after_place = True
 
     def before_place(self, sherd):
         with self.batch.phase("data_collection"):
@@ -80,8 +85,11 @@ class ArchivalCameraStation(StationPlugin):
 
     def after_place(self, sherd):
         b = self.batch
-        standby = b.config["arm"]["standby"]
-        b.move_down(standby[0], standby[1], b.config["arm"]["travel_z"], sherd.grasp_yaw)
+        sx, sy = b.config["arm"]["standby"]
+        # Turn the wrist so the wrist camera (mounted ahead of the gripper) faces away from the
+        # archival camera's view too.
+        cx, cy = self.station.area.center
+        b.move_down(sx, sy, b.config["arm"]["travel_z"], math.atan2(sy - cy, sx - cx))
         with b.phase("data_collection"):
             for attempt in range(self.CAPTURE_ATTEMPTS):
                 try:

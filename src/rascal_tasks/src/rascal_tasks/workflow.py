@@ -68,6 +68,9 @@ class Batch:
         self.progress = progress or (lambda state: None)
         self.log = log or (lambda msg: None)
         self.sherd: Optional[SherdInProgress] = None
+        # Time spent for the sherd in progress (or the next one: surveying counts for it).
+        self.timings = Timings()
+        self.state_times = {}  # state label -> seconds, for the summary and the benchmark
         self.pending: List[Observation] = []
         self.empty_surveys = 0
         self.completed = 0
@@ -85,8 +88,15 @@ class Batch:
         try:
             yield
         finally:
-            if self.sherd is not None:
-                self.sherd.timings.add(name, self.rig.clock.now() - t0)
+            self.timings.add(name, self.rig.clock.now() - t0)
+
+    def finish_sherd(self, completed: bool):
+        if completed:
+            self.completed += 1
+        else:
+            self.lost += 1
+        self.sherd = None
+        self.timings = Timings()
 
     def event(self, sherd, kind: str, detail: str = ""):
         """Log what happened; a sherd's events also go into its catalogue notes."""
@@ -134,10 +144,13 @@ class BatchState(smach.State):
         self.batch = batch
 
     def execute(self, userdata):
-        self.batch.progress(self.label())
+        b = self.batch
+        label = self.label()
+        b.progress(label)
         if self.preempt_requested():
             self.service_preempt()
             return "preempted"
+        t0 = b.rig.clock.now()
         try:
             return self.run()
         except RigError as e:
@@ -146,6 +159,8 @@ class BatchState(smach.State):
                 return "preempted"
             self.batch.event(self.batch.sherd, "rig_error", str(e))
             return "aborted"
+        finally:
+            b.state_times[label] = b.state_times.get(label, 0.0) + b.rig.clock.now() - t0
 
     def label(self) -> str:
         return type(self).__name__
@@ -185,6 +200,7 @@ class Calibrate(BatchState):
             b.rig.perception.calibrate(st.name)
             if st.type == "discard":
                 b.rig.perception.calibrate(b.pickup.name)
+        b.timings = Timings()  # set-up is the batch's, not the first sherd's
         return "done"
 
 
@@ -213,7 +229,8 @@ class Resume(BatchState):
         if b.rig.gripper.holding():
             width = b.rig.gripper.width()
             o = Observation(0, 0, 0, width, width, 0.0, 0, 0, 0, 0, width)
-            b.sherd = SherdInProgress(seq, o, 0.0, 0.01, width, station_index=done)
+            b.sherd = SherdInProgress(seq, o, 0.0, 0.01, width, station_index=done,
+                                      timings=b.timings)
             return "TRANSLATE_%d" % (done + 1)
         for i in range(max(done, 0), len(b.plugins)):
             st = b.plugins[i].station
@@ -224,7 +241,7 @@ class Resume(BatchState):
                 o = seen[0]
                 b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - st.surface_z,
                                           o.width, station_index=done, where=st.name,
-                                          last_xy=(o.x, o.y))
+                                          last_xy=(o.x, o.y), timings=b.timings)
                 return ("REPICK_%d" if i == done else "STATION_%d") % i
         b.recorder.lost(seq, "not found after restart (was %s)" % status)
         b.lost += 1
@@ -270,7 +287,7 @@ class Pickup(BatchState):
             if grasp(b, o, b.pickup.surface_z):
                 seq = b.recorder.new_sherd((o.x, o.y), attempts=attempt + 1)
                 b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - b.pickup.surface_z,
-                                          o.width, last_xy=(o.x, o.y))
+                                          o.width, last_xy=(o.x, o.y), timings=b.timings)
                 b.recorder.dimensions(seq, o.length, o.width, o.height)
                 return "held"
             seen = b.survey_at(b.pickup, o.x, o.y)
@@ -346,7 +363,10 @@ class Place(BatchState):
             b.move_down(*st.place_at, z, s.grasp_yaw, linear=True)
         with b.phase("grasping"):
             b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
-        if not plugin.release_from_above:
+        if plugin.hover_after_place:
+            b.move_down(*st.place_at, z + b.config["arm"]["approach_offset"], s.grasp_yaw,
+                        linear=True)
+        elif not plugin.release_from_above:
             b.move_down(*st.place_at, b.travel_z(), s.grasp_yaw, linear=True)
         s.where, s.last_xy = st.name, st.place_at
         return "placed"
@@ -369,8 +389,7 @@ class AtStation(BatchState):
             return "aborted"
         b.sherd.station_index = self.index
         if self.index == len(b.plugins) - 1:
-            b.completed += 1
-            b.sherd = None
+            b.finish_sherd(completed=True)
         return "done"
 
 
@@ -407,9 +426,8 @@ class Repick(BatchState):
 
 def lose(b: Batch, reason: str) -> str:
     b.event(b.sherd, "lost", reason)
-    b.recorder.lost(b.sherd.seq, reason)
-    b.lost += 1
-    b.sherd = None
+    b.recorder.lost(b.sherd.seq, reason, timings=b.timings.as_dict())
+    b.finish_sherd(completed=False)
     return "lost"
 
 
