@@ -162,7 +162,9 @@ bool within(const Blob& a, const Blob& b, int gap) {
 
 void PhotoSegmenter::mergeFragments(std::vector<Blob>& blobs, const cv::Size& size) const {
   // pieces of one sherd cut apart by dark glaze or paint: a much smaller blob close to a larger one
-  const int near = std::max(2, size.width / 200), far = std::max(4, size.width / 50);
+  // (smaller than any sherd, or a tenth of its neighbour, within 2 % of the photo's width)
+  const int far = std::max(4, size.width / 50);
+  const double tiny = 0.025 * size.width;
   bool merged = true;
   while (merged) {
     merged = false;
@@ -171,7 +173,8 @@ void PhotoSegmenter::mergeFragments(std::vector<Blob>& blobs, const cv::Size& si
         if (i == j) continue;
         const double ratio = static_cast<double>(blobs[i].pixels) / blobs[j].pixels;
         if (ratio >= 0.5) continue;
-        if (!(ratio < 0.15 && within(blobs[i], blobs[j], far)) && !within(blobs[i], blobs[j], near)) continue;
+        const double side = std::max(blobs[i].box.size.width, blobs[i].box.size.height);
+        if (!(ratio < 0.15 || side < tiny) || !within(blobs[i], blobs[j], far)) continue;
         const cv::Rect all = blobs[i].bounds | blobs[j].bounds;
         const cv::Rect canvas =
             cv::Rect(all.x - far, all.y - far, all.width + 2 * far, all.height + 2 * far) & cv::Rect(cv::Point(0, 0), size);
