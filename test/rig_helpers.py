@@ -1,14 +1,22 @@
-"""Starting the whole simulated rig for end-to-end tests, the way a user would (rosrun)."""
+"""Helpers of the end-to-end tests: the simulated rig (rascal_tasks.sim_rig) on the test's
+master, the catalogue, and the simulator's test-only services."""
 import os
 import subprocess
-import time
 
+import psycopg2
+import psycopg2.extras
 import yaml
 
+from rascal_tasks.sim_rig import SimRig
+
 WORKSPACE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CONFIG = os.path.join(WORKSPACE, "config", "rascal.yaml")
-URDF = os.path.join(WORKSPACE, "src", "rascal_description", "urdf", "wx250s.urdf")
 SCENARIOS = os.path.join(WORKSPACE, "config", "scenarios")
+
+
+def start_rig(ros_master, scenario, archive, params=None):
+    params = dict({"/archive/root": str(archive)}, **(params or {}))
+    return SimRig(scenario=scenario, params=params, master_env=ros_master.env,
+                  log_dir=ros_master.log_dir)
 
 
 def migrate(dsn):
@@ -16,69 +24,36 @@ def migrate(dsn):
                    check=True, capture_output=True, text=True)
 
 
-class SimRig:
-    """Master + parameters + sim + arm_controller + sherd_detector; the test runs `rascal`."""
+def rows(dsn, context):
+    with psycopg2.connect(dsn) as conn, conn.cursor(
+            cursor_factory=psycopg2.extras.RealDictCursor) as cur:
+        cur.execute("SELECT * FROM sherds WHERE context_id = %s ORDER BY seq", (context,))
+        return cur.fetchall()
 
-    def __init__(self, ros_master, rosrun, scenario, archive, params=None):
-        self.master = ros_master
-        self.rosrun = rosrun
-        run = ros_master.run
-        run(["rosparam", "load", CONFIG])
-        run(["rosparam", "set", "/use_sim_time", "true"])
-        run(["rosparam", "set", "/robot_description", "-t", URDF])
-        run(["rosparam", "set", "/simulator/scenario", scenario])
-        run(["rosparam", "set", "/archive/root", str(archive)])
-        for key, value in (params or {}).items():
-            run(["rosparam", "set", key, yaml.safe_dump(value, default_flow_style=True).strip()])
-        self.logs = {}
-        for pkg, exe in (("rascal_sim", "sim"), ("rascal_control", "arm_controller"),
-                         ("rascal_perception", "sherd_detector")):
-            log = open(os.path.join(ros_master.log_dir, exe + ".out"), "w")
-            self.logs[exe] = log.name
-            rosrun(pkg, exe, stdout=log, stderr=subprocess.STDOUT)
-        self.wait_for_service("/rascal/perception/detect")
-        self.wait_for_service("/rascal/arm/compute_ik")
-        self.wait_for_service("/sim/ground_truth")
 
-    def wait_for_service(self, name, timeout=60.0):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.master.run(["rosservice", "list"], check=False).stdout.split().count(name):
-                return
-            time.sleep(0.3)
-        raise AssertionError("service %s did not come up; logs: %s" % (name, self.tail()))
+def call(rig, code):
+    """Run a few lines of rospy against the rig; returns what they print, as YAML."""
+    return yaml.safe_load(rig.run(["/usr/bin/python3", "-c", code]).stdout)
 
-    def tail(self, n=15):
-        out = []
-        for exe, path in self.logs.items():
-            with open(path, errors="replace") as f:
-                out.append("--- %s\n%s" % (exe, "".join(f.readlines()[-n:])))
-        return "\n".join(out)
 
-    def rascal(self, *args, dsn, timeout=900, **popen):
-        """Start `rosrun rascal_tasks rascal --dsn DSN ARGS...` (returns the Popen)."""
-        return self.rosrun("rascal_tasks", "rascal", "--dsn", dsn, *args, **popen)
-
-    def ground_truth(self):
-        """name -> (x, y, mass kg) from the simulator's test-only service."""
-        code = ("import rospy, json; from rascal_msgs.srv import GetGroundTruth;"
+def ground_truth(rig):
+    """name -> [x, y, mass kg] from the simulator's test-only service."""
+    return call(rig, "import rospy, json; from rascal_msgs.srv import GetGroundTruth;"
                 "rospy.wait_for_service('/sim/ground_truth', 10);"
                 "r = rospy.ServiceProxy('/sim/ground_truth', GetGroundTruth)();"
                 "print(json.dumps({s.name: [s.pose.position.x, s.pose.position.y, s.mass]"
                 " for s in r.sherds}))")
-        out = self.master.run(["/usr/bin/python3", "-c", code]).stdout
-        return yaml.safe_load(out)
 
-    def inject(self, fault, duration=0.0):
-        code = ("import rospy; from rascal_msgs.srv import InjectFault;"
+
+def inject(rig, fault, duration=0.0):
+    return call(rig, "import rospy; from rascal_msgs.srv import InjectFault;"
                 "rospy.wait_for_service('/sim/inject_fault', 10);"
                 "r = rospy.ServiceProxy('/sim/inject_fault', InjectFault)(%d, %f);"
-                "print(r.success, r.message)" % (fault, duration))
-        return self.master.run(["/usr/bin/python3", "-c", code]).stdout
+                "print([r.success, r.message])" % (fault, duration))
 
-    def joint_positions(self):
-        code = ("import rospy; from sensor_msgs.msg import JointState;"
+
+def joint_positions(rig):
+    return call(rig, "import rospy; from sensor_msgs.msg import JointState;"
                 "rospy.init_node('probe', anonymous=True);"
                 "m = rospy.wait_for_message('/joint_states', JointState, 10);"
                 "print(list(m.position[:6]))")
-        return yaml.safe_load(self.master.run(["/usr/bin/python3", "-c", code]).stdout)

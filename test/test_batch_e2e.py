@@ -6,21 +6,12 @@ import signal
 import subprocess
 import time
 
-import psycopg2
-import psycopg2.extras
 import pytest
-from rig_helpers import SCENARIOS, SimRig, migrate
+from rig_helpers import SCENARIOS, joint_positions, ground_truth, migrate, rows, start_rig
 
 pytestmark = pytest.mark.timeout(900)
 
 SMALL = os.path.join(SCENARIOS, "small_3.yaml")
-
-
-def rows(dsn, context):
-    with psycopg2.connect(dsn) as conn, conn.cursor(
-            cursor_factory=psycopg2.extras.RealDictCursor) as cur:
-        cur.execute("SELECT * FROM sherds WHERE context_id = %s ORDER BY seq", (context,))
-        return cur.fetchall()
 
 
 @pytest.fixture
@@ -30,7 +21,7 @@ def db(pg_dsn):
 
 
 def run_batch(rig, dsn, context, timeout=800):
-    proc = rig.rascal("run", "--context", context, dsn=dsn)
+    proc = rig.rascal("--dsn", dsn, "run", "--context", context)
     try:
         out, _ = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -40,9 +31,22 @@ def run_batch(rig, dsn, context, timeout=800):
     return proc.returncode, out
 
 
-def test_three_sherd_batch_records_every_sherd(ros_master, rosrun, db, tmp_path):
-    rig = SimRig(ros_master, rosrun, SMALL, tmp_path / "archive")
-    truth = rig.ground_truth()
+@pytest.fixture
+def rig_factory(ros_master):
+    rigs = []
+
+    def make(scenario=SMALL, archive=None, params=None):
+        rigs.append(start_rig(ros_master, scenario, archive, params))
+        return rigs[-1]
+
+    yield make
+    for r in rigs:
+        r.stop()
+
+
+def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_path):
+    rig = rig_factory(archive=tmp_path / "archive")
+    truth = ground_truth(rig)
     code, out = run_batch(rig, db, "E2E-3")
     assert code == 0, out[-3000:] + rig.tail()
     recorded = rows(db, "E2E-3")
@@ -66,19 +70,21 @@ def test_three_sherd_batch_records_every_sherd(ros_master, rosrun, db, tmp_path)
         assert img.shape[1] >= 2000 and img.shape[0] >= 1500
         assert (path.with_suffix(".json")).exists()
     report = subprocess.run(["rosrun", "rascal_tasks", "rascal", "--dsn", db, "report",
-                             "--context", "E2E-3"], env=ros_master.env, capture_output=True,
-                            text=True)
+                             "--context", "E2E-3", "--archive", str(tmp_path / "archive")],
+                            env=ros_master.env, capture_output=True, text=True)
     assert report.returncode == 0, report.stderr
+    page = (tmp_path / "archive" / "E2E-3" / "report" / "index.html").read_text()
+    assert page.count("<img ") == 3 and "<svg" in page
 
 
-def test_database_down_gives_clear_error_and_arm_does_not_move(ros_master, rosrun, tmp_path):
-    rig = SimRig(ros_master, rosrun, SMALL, tmp_path / "archive")
-    before = rig.joint_positions()
-    proc = rig.rascal("run", "--context", "E2E-DOWN",
-                      dsn="postgresql://rascal:rascal@127.0.0.1:1/rascal")
+def test_database_down_gives_clear_error_and_arm_does_not_move(rig_factory, tmp_path):
+    rig = rig_factory(archive=tmp_path / "archive")
+    before = joint_positions(rig)
+    proc = rig.rascal("--dsn", "postgresql://rascal:rascal@127.0.0.1:1/rascal", "run",
+                      "--context", "E2E-DOWN")
     out, _ = proc.communicate(timeout=120)
     assert proc.returncode == 3
     assert "database" in out and "cannot connect" in out
     time.sleep(1.0)
-    after = rig.joint_positions()
+    after = joint_positions(rig)
     assert max(abs(a - b) for a, b in zip(before, after, strict=True)) < 1e-3

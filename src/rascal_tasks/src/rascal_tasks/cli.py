@@ -192,7 +192,8 @@ def cmd_report(args, out):
                'drops': sum(r.get('drops') or 0 for r in records),
                'mean time per recorded sherd': '%.1f s' % (sum(totals) / len(totals))
                if totals else '–'}
-    report = write_report(args.context, records, cfg.resolve(cfg['archive']['root']), summary)
+    archive = args.archive or cfg.resolve(cfg['archive']['root'])
+    report = write_report(args.context, records, archive, summary)
     print('report: %s' % report, file=out)
     return 0
 
@@ -206,6 +207,7 @@ def _add_run(sub):
 def _add_report(sub):
     rep = sub.add_parser('report', help="write an HTML report of a context's sherds")
     rep.add_argument('--context', required=True, help='context id, e.g. TR1-1023')
+    rep.add_argument('--archive', help='image archive root (default: archive.root of the config)')
     rep.set_defaults(func=cmd_report)
 
 
