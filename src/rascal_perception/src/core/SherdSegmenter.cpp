@@ -95,7 +95,7 @@ std::vector<cv::Mat> SherdSegmenter::split(const cv::Mat& mask, double min_neck,
   // peaks: local maxima of the distance, at least 35 % of the deepest
   const int r = std::max(2, static_cast<int>(0.3 * maxd));
   cv::Mat dilated;
-  cv::dilate(dist, dilated, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+  cv::dilate(dist, dilated, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1)));
   const double floor = std::max(min_peak_px, 0.35 * maxd);
   cv::Mat peak_mask = (dist >= dilated) & (dist >= floor);
   cv::Mat peak_labels, peak_stats, centroids;

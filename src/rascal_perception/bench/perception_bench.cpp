@@ -1,0 +1,62 @@
+// Perception speed: median and 99th percentile time per 640 x 480 wrist frame for segmentation
+// alone (SherdDetector::segment: background, fixtures, depth, blobs, splitting) and for a full
+// detect (plus the plane, measurement, grasps, order), on frames rendered by the simulator's
+// core (generated scenes, 6..10 sherds, lighting 0.3 .. 1.5 x). Run it on one core:
+//   taskset -c 0 perception_bench [frames]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "../test/SimScenes.hpp"
+#include "rascal_perception/SherdDetector.hpp"
+
+using namespace rascal_perception;
+using namespace rascal_perception_test;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+void report(const char* what, std::vector<double> t) {
+  std::sort(t.begin(), t.end());
+  const double median = t[t.size() / 2];
+  const double p99 = t[std::min(t.size() - 1, static_cast<size_t>(0.99 * (t.size() - 1) + 0.5))];
+  std::printf("%-34s median %6.2f ms   p99 %6.2f ms   (%zu frames)\n", what, median, p99, t.size());
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int scenes = argc > 1 ? std::max(1, std::stoi(argv[1])) : 40;
+  const int repeats = 5;
+  std::vector<double> seg, det;
+  size_t sherds = 0;
+  for (int i = 0; i < scenes; ++i) {
+    const unsigned seed = 1000 + i;
+    const double brightness = 0.3 + 1.2 * (i % 7) / 6.0;
+    rascal_sim::Scenario sc = generated(seed, 6 + i % 5, brightness, 3000 + 1000 * (i % 6), 0.3);
+    rascal_sim::Scenario empty = sc;
+    empty.sherds.clear();
+    const Frame cal = render(empty, surveyJoints());
+    const Frame f = render(sc, surveyJoints());
+    SherdDetector d{PerceptionConfig()};
+    d.calibrate("pickup", cal.rgb, cal.depth, cal.view, 0.0);
+    cv::Mat fg;
+    for (int k = 0; k < repeats; ++k) {
+      auto t0 = Clock::now();
+      d.segment("pickup", f.rgb, f.depth, f.view, 0.0, fg);
+      auto t1 = Clock::now();
+      const DetectionResult r = d.detect("pickup", f.rgb, f.depth, f.view, 0.0);
+      auto t2 = Clock::now();
+      seg.push_back(ms(t1 - t0));
+      det.push_back(ms(t2 - t1));
+      if (k == 0) sherds += r.sherds.size();
+    }
+  }
+  std::printf("perception bench: %d scenes x %d runs, %zu sherds detected (%.1f per frame)\n", scenes, repeats,
+              sherds, static_cast<double>(sherds) / scenes);
+  report("segmentation (segment)", seg);
+  report("full detect (detect)", det);
+  return 0;
+}
