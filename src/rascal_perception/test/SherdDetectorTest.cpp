@@ -115,7 +115,7 @@ void save(const std::string& name, const Frame& f, const DetectionResult& r) {
   const char* dir = std::getenv("RASCAL_PERCEPTION_DUMP");
   if (!dir) return;
   cv::Mat bgr;
-  cv::cvtColor(Annotator::draw(f.rgb, r.sherds), bgr, cv::COLOR_RGB2BGR);
+  cv::cvtColor(Annotator::draw(f.rgb, r.sherds, cv::Mat(), &f.view), bgr, cv::COLOR_RGB2BGR);
   cv::imwrite(std::string(dir) + "/" + name + ".png", bgr);
 }
 

@@ -191,14 +191,18 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
     why = "longer than perception.max_sherd_size";
     return false;
   }
-  // the colour-image box
+  // the colour-image box: its long side's direction from its corners (no angle convention)
   const cv::RotatedRect& b = blob.box;
-  const bool w_long = b.size.width >= b.size.height;
+  cv::Point2f q[4];
+  b.points(q);
+  const cv::Point2f s1 = q[1] - q[0], s2 = q[2] - q[1];
+  const double n1 = std::hypot(s1.x, s1.y), n2 = std::hypot(s2.x, s2.y);
+  const cv::Point2f along = n1 >= n2 ? s1 : s2;
   out.image_box[0] = b.center.x;
   out.image_box[1] = b.center.y;
-  out.image_box[2] = std::max(b.size.width, b.size.height);
-  out.image_box[3] = std::min(b.size.width, b.size.height);
-  out.image_box[4] = static_cast<float>(wrapHalfPi(b.angle * M_PI / 180.0 + (w_long ? 0.0 : M_PI / 2)));
+  out.image_box[2] = static_cast<float>(std::max(n1, n2));
+  out.image_box[3] = static_cast<float>(std::min(n1, n2));
+  out.image_box[4] = static_cast<float>(wrapHalfPi(std::atan2(along.y, along.x)));
   out.contour = blob.contour;
   return true;
 }

@@ -259,7 +259,7 @@ bool SherdDetectorNode::onDetect(rascal_msgs::Detect::Request& req, rascal_msgs:
     markers_pub_.publish(conversions::markers(r.sherds, header));
     if (annotated_pub_.getNumSubscribers() > 0 || annotated_pub_.isLatched()) {
       std_msgs::Header image_header = frame.colour->header;
-      annotated_pub_.publish(conversions::toImage(Annotator::draw(rgb, r.sherds), image_header));
+      annotated_pub_.publish(conversions::toImage(Annotator::draw(rgb, r.sherds, cv::Mat(), &view), image_header));
     }
   } catch (const std::exception& e) {
     res.success = false;
