@@ -241,4 +241,39 @@ TEST(SherdDetector, BackgroundCalibratedInDimLightWorksInBrightLight) {
     }
   }
 }
+TEST(SherdDetector, OneSherdOnTheScaleAndAtTheCameraStation) {
+  // the scale's two-tone platform 25 mm up; the archival station's colour chart and scale bar
+  const rascal_sim::Scenario base = generated(301, 1, 0.8, 5000, 0.0);
+  struct Case {
+    std::string station;
+    Eigen::Vector2d where;
+    double surface;
+  };
+  for (const Case& c : {Case{"scale", layout().scale.position, layout().scale_surface_z},
+                        Case{"camera", layout().camera_place_at, 0.0}}) {
+    rascal_sim::Scenario sc = base;
+    sc.sherds[0].pose = Eigen::Vector3d(c.where.x(), c.where.y(), 0.4);
+    rascal_sim::Scenario empty = sc;
+    empty.sherds.clear();
+    const rascal_sim::JointVector q = cameraOver(c.where);
+    const Frame cal = render(empty, q), f = render(sc, q);
+    SherdDetector d(config());
+    const CalibrationResult k = d.calibrate(c.station, cal.rgb, cal.depth, cal.view, c.surface);
+    ASSERT_TRUE(k.success) << k.message;
+    const DetectionResult r = d.detect(c.station, f.rgb, f.depth, f.view, c.surface);
+    save("station_" + c.station, f, r);
+    std::printf("%s: %s; %zu detections, fixture %.1f %%\n", c.station.c_str(), k.message.c_str(), r.sherds.size(),
+                100 * k.fixture_fraction);
+    ASSERT_EQ(r.sherds.size(), 1u) << c.station;
+    const SherdDetection& s = r.sherds[0];
+    double l, w;
+    Eigen::Vector2d centre;
+    f.truth[0].extents(s.yaw, l, w, centre);
+    EXPECT_LT((s.centre.head<2>() - centre).norm(), 0.003) << c.station;
+    EXPECT_NEAR(s.length, l, 0.003) << c.station;
+    EXPECT_NEAR(s.centre.z(), f.truth[0].top, 0.002) << c.station;
+    EXPECT_NEAR(s.surface, c.surface, 0.002) << c.station;
+  }
+}
+
 TEST(Print, SurveyJoints) { const auto& q = rascal_perception_test::surveyJoints(); std::printf("survey joints: %.4f %.4f %.4f %.4f %.4f %.4f\n", q[0], q[1], q[2], q[3], q[4], q[5]); }

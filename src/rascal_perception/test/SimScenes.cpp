@@ -46,21 +46,22 @@ JointVector pointDown(double x, double y, double z) {
   return best;
 }
 
+JointVector cameraOver(const Eigen::Vector2d& goal, double ee_z) {
+  // wrist_rotate undoes the waist; the gripper goes where the camera's offset from it puts the
+  // camera over the goal
+  Eigen::Vector2d target = goal;
+  JointVector j{};
+  for (int i = 0; i < 3; ++i) {
+    j = pointDown(target.x(), target.y(), ee_z);
+    j[5] = -j[0];
+    const auto T = ArmKinematics::forward(j, 0.037);
+    target += goal - T[kCameraColorOpticalFrame].translation().head<2>();
+  }
+  return j;
+}
+
 const JointVector& surveyJoints() {
-  // camera over the mat's centre, image rows along the mat: wrist_rotate undoes the waist, and the
-  // gripper goes where the camera's offset from it puts the camera over the centre
-  static const JointVector q = [] {
-    const Eigen::Vector2d goal = layout().pickup.position;
-    Eigen::Vector2d target = goal;
-    JointVector j{};
-    for (int i = 0; i < 3; ++i) {
-      j = pointDown(target.x(), target.y(), 0.25);
-      j[5] = -j[0];
-      const auto T = ArmKinematics::forward(j, 0.037);
-      target += goal - T[kCameraColorOpticalFrame].translation().head<2>();
-    }
-    return j;
-  }();
+  static const JointVector q = cameraOver(layout().pickup.position);
   return q;
 }
 

@@ -31,6 +31,8 @@ struct Frame {
 const rascal_sim::WorldLayout& layout();
 /// Joints putting ee_gripper_link at (x, y, z) pointing straight down.
 rascal_sim::JointVector pointDown(double x, double y, double z);
+/// Joints putting the wrist camera over `goal` (x, y), image rows along base_link x.
+rascal_sim::JointVector cameraOver(const Eigen::Vector2d& goal, double ee_z = 0.25);
 /// Survey joints over the pickup mat (computed once).
 const rascal_sim::JointVector& surveyJoints();
 /// Renders one wrist frame of `scenario` at joints q (no physics steps: sherds rest where spawned).
