@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 
 #include "rascal_sim/MunsellTable.hpp"
@@ -66,11 +67,18 @@ const JointVector& surveyJoints() {
 }
 
 Frame render(const Scenario& scenario, const JointVector& q) {
-  SimulatorOptions o;
-  o.initial_joints = q;
-  o.archival_width = 64;
-  o.archival_height = 48;
-  Simulator sim(layout(), o);
+  // one simulator per arm pose, reloaded with each scenario (building one costs more than a frame)
+  static std::unique_ptr<Simulator> cached;
+  static JointVector cached_q{};
+  if (!cached || cached_q != q) {
+    SimulatorOptions o;
+    o.initial_joints = q;
+    o.archival_width = 64;
+    o.archival_height = 48;
+    cached = std::make_unique<Simulator>(layout(), o);
+    cached_q = q;
+  }
+  Simulator& sim = *cached;
   sim.load(scenario);
   WristFrame w = sim.renderWristFrame();
   Frame f;
