@@ -19,6 +19,7 @@ from typing import Dict, List, Optional, Tuple
 
 import yaml
 
+from rascal_tasks.stations import STATION_PLUGINS
 from rascal_tasks.survey import lawnmower
 
 # --- wx250s geometry for the reach check (shared/facts/widowx250_d435.md §1.1, §1.5) -------------
@@ -31,7 +32,8 @@ WRIST_TO_EE = 0.065 + 0.043 + 0.023 + 0.027575  # wrist_angle axis -> ee_gripper
 MAX_WRIST_DISTANCE = 0.95 * (UPPER_ARM + FOREARM)
 MIN_RADIUS = 0.10
 
-STATION_TYPES = ("pickup", "scale", "archival_camera", "discard")
+# Every station type with a plug-in (stations.py) can appear in the config; these four must.
+REQUIRED_STATION_TYPES = ("pickup", "scale", "archival_camera", "discard")
 SELECTION_POLICIES = ("nearest", "largest", "most_isolated")
 ARM_JOINTS = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
 
@@ -344,7 +346,7 @@ def _read_stations(sec: _Reader) -> Dict[str, Station]:
         if not isinstance(name, str) or not name.replace("_", "").isalnum():
             sec.fail(name, "station names are snake_case words", name, show_got=False)
         st = sec.section(name)
-        type_ = st.string("type", choices=STATION_TYPES)
+        type_ = st.string("type", choices=("pickup",) + tuple(STATION_PLUGINS))
         area = Rect(st.xy("position"), st.size("size"))
         surface_z = st.number("surface_z", 0.0, 0.2, "metres above the table")
         extra = {}
@@ -376,7 +378,7 @@ def _read_stations(sec: _Reader) -> Dict[str, Station]:
         st.done()
         stations[name] = Station(name, type_, area, surface_z, place_at, **extra)
 
-    for type_ in STATION_TYPES:
+    for type_ in REQUIRED_STATION_TYPES:
         _only(stations, type_, sec)
     names = list(stations)
     for i, a in enumerate(names):

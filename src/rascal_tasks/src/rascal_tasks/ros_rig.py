@@ -18,7 +18,7 @@ from rascal_msgs.msg import ScaleReading as ScaleReadingMsg
 from rascal_msgs.srv import CalibrateBackground, CaptureArchival, Detect
 from rascal_tasks import rig
 
-SERVICE_WAIT = 10.0  # s (wall clock): how long a node may take to come up
+SERVICE_WAIT = 30.0  # s (wall clock): how long a node may take to come up
 # Fingers closed on nothing stop at 30 mm (facts §1.4); a sherd keeps them at least a few mm
 # wider. Below this the gripper is taken to be empty.
 EMPTY_OPENING = 0.030 + 0.003
@@ -30,13 +30,19 @@ def _yaw(q) -> float:
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
+def _gripper_yaw(q) -> float:
+    """Yaw of a gripper-pointing-down orientation R = Rz(yaw) Ry(pi/2), from its closing axis
+    R y = (-sin yaw, cos yaw, 0). (The usual Euler formula is degenerate at pitch pi/2.)"""
+    return math.atan2(2.0 * (q.w * q.z - q.x * q.y), 1.0 - 2.0 * (q.x * q.x + q.z * q.z))
+
+
 def observation_from_msg(s) -> rig.Observation:
     """rascal_msgs/Sherd -> Observation (both in base_link)."""
     return rig.Observation(
         x=s.pose.position.x, y=s.pose.position.y, yaw=_yaw(s.pose.orientation),
         length=s.length, width=s.width, height=s.height,
         grasp_x=s.grasp_pose.position.x, grasp_y=s.grasp_pose.position.y,
-        grasp_z=s.grasp_pose.position.z, grasp_yaw=_yaw(s.grasp_pose.orientation),
+        grasp_z=s.grasp_pose.position.z, grasp_yaw=_gripper_yaw(s.grasp_pose.orientation),
         grasp_width=s.grasp_width, colour=(s.color.r, s.color.g, s.color.b), score=s.score)
 
 

@@ -11,6 +11,9 @@ from typing import Dict, Type
 from rascal_tasks.rig import RigError
 
 STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
+# The smallest sherd worth recording: 2 x 2 cm, 4 mm wall at 1.8 g/cm^3 is about 2.9 g
+# (shared/facts/sherds_and_colour.md §2). A lighter reading means the sherd is not on the scale.
+MIN_SHERD_MASS = 0.001  # kg
 
 
 def station_type(name: str):
@@ -68,9 +71,9 @@ class ScaleStation(StationPlugin):
                     break
                 self.batch.event(sherd, "scale_unstable", "attempt %d: %.1f g" % (
                     attempt + 1, reading.mass * 1000))
-        if reading.mass <= 0.0:
-            self.batch.event(sherd, "scale_failed", "reads %.1f g with the sherd on it" % (
-                reading.mass * 1000))
+        if reading.mass < MIN_SHERD_MASS:
+            self.batch.event(sherd, "scale_failed", "reads %.1f g with the sherd on it; is it "
+                             "still in the gripper or off the platform?" % (reading.mass * 1000))
             return "failed"
         sherd.mass = reading.mass
         # An unstable last reading is still recorded, and flagged in the sherd's notes.

@@ -1,0 +1,37 @@
+"""Core tests of the ROS adapters' conversions (no master needed)."""
+import math
+
+import pytest
+
+pytest.importorskip("rascal_msgs")
+
+from rascal_control.arm import quaternion_from_rpy  # noqa: E402
+from rascal_msgs.msg import Sherd  # noqa: E402
+
+from rascal_tasks.ros_rig import observation_from_msg  # noqa: E402
+
+
+@pytest.mark.parametrize("yaw", [-3.0, -1.2, -0.4, 0.0, 0.5, 1.21, 1.57, 2.9])
+def test_grasp_yaw_survives_the_pitched_orientation(yaw):
+    """The gripper points down (pitch pi/2), where Euler yaw extraction is degenerate."""
+    s = Sherd()
+    (s.grasp_pose.orientation.x, s.grasp_pose.orientation.y, s.grasp_pose.orientation.z,
+     s.grasp_pose.orientation.w) = quaternion_from_rpy(0.0, math.pi / 2, yaw)
+    s.pose.orientation.w = 1.0
+    o = observation_from_msg(s)
+    assert o.grasp_yaw == pytest.approx(yaw, abs=1e-9)
+
+
+def test_sherd_fields_are_carried_over():
+    s = Sherd()
+    s.pose.position.x, s.pose.position.y = 0.12, 0.25
+    s.pose.orientation.z, s.pose.orientation.w = math.sin(0.3), math.cos(0.3)
+    s.length, s.width, s.height, s.grasp_width = 0.05, 0.03, 0.008, 0.042
+    s.grasp_pose.position.z = 0.01
+    s.grasp_pose.orientation.w = 1.0
+    s.color.r, s.color.g, s.color.b = 0.6, 0.4, 0.3
+    o = observation_from_msg(s)
+    assert (o.x, o.y, o.length, o.width, o.height) == (0.12, 0.25, 0.05, 0.03, 0.008)
+    assert o.yaw == pytest.approx(0.6)
+    assert (o.grasp_z, o.grasp_width) == (0.01, 0.042)
+    assert o.colour == pytest.approx((0.6, 0.4, 0.3))
