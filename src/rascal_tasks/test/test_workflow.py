@@ -43,10 +43,9 @@ def test_machine_visits_the_stations_in_config_order(data):
 
 def test_every_state_outcome_is_wired(data):
     sm = workflow.build_machine(_batch(config_from_dict(data)))
+    sm.check_consistency()  # raises InvalidTransitionError for a dangling outcome
     for label, state in sm.get_children().items():
-        wired = sm._transitions[label] if hasattr(sm, "_transitions") else None
-        if wired is not None:
-            assert set(state.get_registered_outcomes()) <= set(wired), label
+        assert set(state.get_registered_outcomes()) <= set(sm._transitions[label]), label
 
 
 def test_a_new_station_type_is_a_class_and_a_config_entry(data, monkeypatch):
