@@ -10,7 +10,7 @@ import threading
 import rospy
 from rascal_control import Arm as ControlArm
 from rascal_control import Gripper as ControlGripper
-from rascal_control.results import ControlError
+from rascal_control.results import ControlError, Timeout
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
@@ -70,13 +70,19 @@ class RosArm(rig.Arm):
         self.speed_scale = speed_scale
 
     def move_down(self, x, y, z, yaw, linear=False):
-        try:
-            res = self._arm.move_to(ControlArm.top_down(x, y, z, yaw),
-                                    motion="linear" if linear else "joint",
-                                    speed_scale=self.speed_scale)
-        except ControlError as e:
-            raise _rig_error("arm", e) from None
-        return res.duration
+        pose = ControlArm.top_down(x, y, z, yaw)
+        for attempt in range(2):
+            try:
+                return self._arm.move_to(pose, motion="linear" if linear else "joint",
+                                         speed_scale=self.speed_scale).duration
+            except Timeout as e:
+                # The arm did not arrive (a stalled or lost trajectory): send the goal once more
+                # from where it is; a second timeout is a fault for a person to look at.
+                if attempt:
+                    raise _rig_error("arm", e) from None
+                rospy.logwarn("arm: %s; trying the move once more", e.message)
+            except ControlError as e:
+                raise _rig_error("arm", e) from None
 
     def go(self, named):
         try:
@@ -136,19 +142,34 @@ class RosGripper(rig.Gripper):
 
 
 class RosPerception(rig.Perception):
+    """The detector's services. A failed call is retried a few times after a short wait: right
+    after a move the newest image or transform may still be on its way."""
+
+    ATTEMPTS = 4
+    RETRY_WAIT = 0.3  # s (ROS time)
+
     def __init__(self):
         self._detect = _proxy("/rascal/perception/detect", Detect)
         self._calibrate = _proxy("/rascal/perception/calibrate_background", CalibrateBackground)
 
+    def _call(self, proxy, station, what):
+        for attempt in range(self.ATTEMPTS):
+            try:
+                res = proxy(station)
+            except rospy.ServiceException as e:
+                raise rig.RigError("perception", what, str(e)) from None
+            if res.success:
+                return res
+            rospy.logwarn("perception %s at %s failed (attempt %d): %s", what.lower(), station,
+                          attempt + 1, res.message)
+            rospy.sleep(self.RETRY_WAIT)
+        raise rig.RigError("perception", what, res.message)
+
     def calibrate(self, station):
-        res = self._calibrate(station)
-        if not res.success:
-            raise rig.RigError("perception", "CALIBRATION", res.message)
+        self._call(self._calibrate, station, "CALIBRATION")
 
     def detect(self, station):
-        res = self._detect(station)
-        if not res.success:
-            raise rig.RigError("perception", "DETECT", res.message)
+        res = self._call(self._detect, station, "DETECT")
         return [observation_from_msg(s) for s in res.detections.sherds]
 
 
