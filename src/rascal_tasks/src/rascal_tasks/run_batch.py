@@ -91,6 +91,7 @@ def run(context: str, dsn: str = None) -> int:
         stop.set()
         print("\nstopping: parking the arm (Ctrl-C again stops it where it is)",
               file=sys.stderr)
+        batch.stop_requested.set()
         machine.request_preempt()
 
     signal.signal(signal.SIGINT, on_sigint)

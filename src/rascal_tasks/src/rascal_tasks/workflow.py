@@ -11,6 +11,7 @@ progress callback are injected.
 """
 import contextlib
 import math
+import threading
 from dataclasses import dataclass, field
 from typing import Callable, List, Optional
 
@@ -71,6 +72,7 @@ class Batch:
         # Time spent for the sherd in progress (or the next one: surveying counts for it).
         self.timings = Timings()
         self.state_times = {}  # state label -> seconds, for the summary and the benchmark
+        self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
         self.pending: List[Observation] = []
         self.empty_surveys = 0
         self.completed = 0
@@ -104,7 +106,12 @@ class Batch:
         if sherd is not None:
             self.recorder.note(sherd.seq, "%s: %s" % (kind, detail))
 
+    def check_stop(self):
+        if self.stop_requested.is_set():
+            raise RigError("batch", "PREEMPTED", "stop requested")
+
     def move_down(self, x, y, z, yaw, linear=False):
+        self.check_stop()
         with self.phase("locomotion"):
             self.rig.arm.move_down(x, y, z, yaw, linear=linear)
 
@@ -301,9 +308,9 @@ class Pickup(BatchState):
 
 
 def grasp(b: Batch, o: Observation, surface_z: float) -> bool:
-    margin = b.config["arm"]["grasp_margin"]
+    """Open to the planned width (it includes the grasp margin), descend, close, lift."""
     with b.phase("grasping"):
-        b.rig.gripper.open(opening_for(o.grasp_width, margin))
+        b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
     approach = o.grasp_z + b.config["arm"]["approach_offset"]
     b.move_down(o.grasp_x, o.grasp_y, approach, o.grasp_yaw)
     b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)
@@ -314,7 +321,7 @@ def grasp(b: Batch, o: Observation, surface_z: float) -> bool:
         held = False  # slipped out while lifting
     if not held:
         with b.phase("grasping"):
-            b.rig.gripper.open(opening_for(o.grasp_width, margin))
+            b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
     return held
 
 
