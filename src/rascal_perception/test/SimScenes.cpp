@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 
@@ -68,15 +69,14 @@ const JointVector& surveyJoints() {
 
 Frame render(const Scenario& scenario, const JointVector& q) {
   // one simulator per arm pose, reloaded with each scenario (building one costs more than a frame)
-  static std::unique_ptr<Simulator> cached;
-  static JointVector cached_q{};
-  if (!cached || cached_q != q) {
+  static std::map<JointVector, std::unique_ptr<Simulator>> cache;
+  std::unique_ptr<Simulator>& cached = cache[q];
+  if (!cached) {
     SimulatorOptions o;
     o.initial_joints = q;
     o.archival_width = 64;
     o.archival_height = 48;
     cached = std::make_unique<Simulator>(layout(), o);
-    cached_q = q;
   }
   Simulator& sim = *cached;
   sim.load(scenario);
