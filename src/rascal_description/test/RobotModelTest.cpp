@@ -147,6 +147,19 @@ TEST(RobotModel, EveryLinkWithGeometryHasSimpleCollision) {
   EXPECT_GE(with_collision, 12);
 }
 
+TEST(RobotModel, FingertipsEndJustBeyondEeGripperLink) {
+  // The fingertips end 4.4 mm (to 0.1 mm) beyond ee_gripper_link (fingers_link + 0.027575), as in the
+  // simulator's finger boxes and the detector's grasp planner (perception.fingertip_offset).
+  auto model = loadModel();
+  for (const char* name : {"left_finger_link", "right_finger_link"}) {
+    auto col = model->getLink(name)->collision;
+    ASSERT_TRUE(col) << name;
+    auto box = std::dynamic_pointer_cast<urdf::Box>(col->geometry);
+    ASSERT_TRUE(box) << name;
+    EXPECT_NEAR(col->origin.position.x + box->dim.x / 2 - 0.027575, 0.0044, 5e-5) << name;
+  }
+}
+
 TEST(RobotModel, CameraOpticalFrameLooksAlongGripperAxis) {
   // With the arm at home the gripper points along +x, so the optical z axis (REP 103 optical
   // convention: z forward, x right, y down) must point along +x of base_link and y down.
