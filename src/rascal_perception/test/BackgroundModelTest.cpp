@@ -65,3 +65,20 @@ TEST(BackgroundModel, RejectsBadInput) {
   cv::Mat hsv, bg;
   EXPECT_THROW(m.classify(hsv, cv::Mat(), bg), std::logic_error);
 }
+
+TEST(BackgroundModel, RefreshLearnsTheNewLightWithoutTheSherds) {
+  BackgroundModel m;
+  m.learn(station(1.0), BackgroundOptions());
+  // warmer light later: the mat shifts hue; a sherd lies on it and is left out of the refresh
+  cv::Mat later(240, 320, CV_8UC3, cv::Scalar(150, 128, 90));
+  cv::rectangle(later, cv::Rect(40, 30, 240, 180), cv::Scalar(60, 50, 140), cv::FILLED);
+  cv::Mat sherd = cv::Mat::zeros(later.size(), CV_8U);
+  cv::circle(sherd, cv::Point(100, 120), 20, cv::Scalar(255), cv::FILLED);
+  later.setTo(cv::Scalar(194, 133, 102), sherd);
+  m.refresh(later, sherd);
+  cv::Mat hsv, bg;
+  cv::cvtColor(later, hsv, cv::COLOR_RGB2HSV_FULL);
+  m.classify(hsv, m.seenMap(), bg);
+  EXPECT_EQ(bg.at<uint8_t>(120, 200), 255);  // the mat in the new light
+  EXPECT_EQ(bg.at<uint8_t>(120, 100), 0);    // the sherd
+}

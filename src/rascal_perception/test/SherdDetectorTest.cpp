@@ -238,6 +238,12 @@ TEST(SherdDetector, BackgroundCalibratedInDimLightWorksInBrightLight) {
       score(f, r, t, "calibrated at " + std::to_string(calib) + ", run at " + std::to_string(run));
       EXPECT_EQ(t.found, t.expected);
       EXPECT_EQ(t.false_positives, 0);
+      // the colours re-learnt from this frame (sherds left out) still find them all
+      ASSERT_TRUE(d.refresh("pickup", f.rgb, f.depth, f.view, 0.0).success);
+      Tally after;
+      score(f, d.detect("pickup", f.rgb, f.depth, f.view, 0.0), after, "refreshed, seed " + std::to_string(seed));
+      EXPECT_EQ(after.found, after.expected);
+      EXPECT_EQ(after.false_positives, 0);
     }
   }
 }

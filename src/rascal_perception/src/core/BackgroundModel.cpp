@@ -60,9 +60,37 @@ void BackgroundModel::refresh(const cv::Mat& rgb, const cv::Mat& ignore) {
   if (!ready()) throw std::logic_error("BackgroundModel::refresh: learn() first");
   cv::Mat hsv;
   cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV_FULL);
-  const size_t before = clusters_.size();
+  const std::vector<BackgroundCluster> before = clusters_;
   cluster(hsv, ignore);
-  if (clusters_.size() != before) seen_.setTo(0xFF);  // cluster indices changed: no prior
+  // carry the seen-map over: each old cluster's bit goes to the new cluster nearest in chroma;
+  // a new cluster that is nobody's nearest may appear anywhere
+  auto chroma = [](const BackgroundCluster& c) {
+    return cv::Point2d(c.saturation * std::cos(kTwoPi * c.hue), c.saturation * std::sin(kTwoPi * c.hue));
+  };
+  std::vector<int> to(before.size(), 0);
+  uint8_t claimed = 0;
+  for (size_t o = 0; o < before.size(); ++o) {
+    double best = 1e9;
+    for (size_t n = 0; n < clusters_.size(); ++n) {
+      const double d = cv::norm(chroma(before[o]) - chroma(clusters_[n]));
+      if (d < best) {
+        best = d;
+        to[o] = static_cast<int>(n);
+      }
+    }
+    claimed |= static_cast<uint8_t>(1 << to[o]);
+  }
+  cv::Mat seen = cv::Mat::zeros(seen_.size(), CV_8U);
+  for (size_t o = 0; o < before.size(); ++o) {
+    cv::bitwise_or(seen, cv::Scalar(1 << to[o]), seen, (seen_ & cv::Scalar(1 << o)) != 0);
+  }
+  uint8_t everywhere = 0;
+  for (size_t n = 0; n < clusters_.size(); ++n) {
+    if (!(claimed & (1 << n))) everywhere |= static_cast<uint8_t>(1 << n);
+  }
+  if (everywhere) seen |= cv::Scalar(everywhere);
+  seen.setTo(0xFF, seen_ == 0xFF);
+  seen_ = seen;
 }
 
 void BackgroundModel::cluster(const cv::Mat& hsv, const cv::Mat& ignore) {

@@ -99,6 +99,7 @@ void SherdDetectorNode::readParameters(ros::NodeHandle& nh) {
   c.split_min_neck = optional(nh, "/perception/split_min_neck", c.split_min_neck, 0.1, 1.0);
   c.min_sherd_height = optional(nh, "/perception/min_sherd_height", c.min_sherd_height, 0.0005, 0.05);
   wait_s_ = optional(nh, "/perception/frame_wait", wait_s_, 0.05, 10.0);
+  refresh_period_ = optional(nh, "/perception/refresh_period", refresh_period_, 0.0, 86400.0);
   c.grasp_margin = number(nh, "/arm/grasp_margin", 0.0, 0.05);
 
   XmlRpc::XmlRpcValue stations;
@@ -211,6 +212,7 @@ bool SherdDetectorNode::onCalibrate(rascal_msgs::CalibrateBackground::Request& r
     }
     std::lock_guard<std::mutex> lock(detector_mutex_);
     const CalibrationResult r = detector_->calibrate(req.station, rgb, depth, view, station->second);
+    if (r.success) refreshed_[req.station] = frame.colour->header.stamp;
     res.success = r.success;
     res.message = r.message;
     res.clusters = r.clusters;
@@ -246,6 +248,13 @@ bool SherdDetectorNode::onDetect(rascal_msgs::Detect::Request& req, rascal_msgs:
     {
       std::lock_guard<std::mutex> lock(detector_mutex_);
       r = detector_->detect(req.station, rgb, depth, view, station->second);
+      // the paper refreshes its colour masks now and then: light drifts during a batch
+      const ros::Time stamp = frame.colour->header.stamp;
+      if (r.success && refresh_period_ > 0 && (stamp - refreshed_[req.station]).toSec() >= refresh_period_) {
+        const CalibrationResult f = detector_->refresh(req.station, rgb, depth, view, station->second);
+        if (f.success) refreshed_[req.station] = stamp;
+        ROS_INFO_STREAM("sherd_detector: " << f.message);
+      }
     }
     res.success = r.success;
     res.message = r.message;

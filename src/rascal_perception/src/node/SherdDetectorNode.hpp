@@ -43,6 +43,8 @@ class SherdDetectorNode {
   PerceptionConfig config_;
   std::map<std::string, double> surfaces_;  ///< station -> surface_z
   double wait_s_ = 1.0;
+  double refresh_period_ = 0.0;  ///< [s] re-learn a station's colours after a detect this often (0 = never)
+  std::map<std::string, ros::Time> refreshed_;  ///< last calibration or refresh per station
   std::string base_frame_ = "base_link";
 
   std::mutex mutex_;  ///< guards the frame buffers and camera info
