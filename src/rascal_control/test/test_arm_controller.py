@@ -169,7 +169,7 @@ class TestAgainstTheSimulator:
     def rig(self, ros_master, rosrun):
         ros_master.run(["rosparam", "load", CONFIG])
         ros_master.run(["rosparam", "set", "/use_sim_time", "true"])
-        ros_master.run(["rosparam", "set", "/simulator/real_time_factor", "1.0"])
+        ros_master.run(["rosparam", "set", "/simulator/real_time_factor", "0.0"])
         ros_master.run(["rosparam", "set", "/simulator/wrist_camera", "false"])
         rosrun("rascal_sim", "sim")
         wait_for(ros_master, "topic", "/joint_states")

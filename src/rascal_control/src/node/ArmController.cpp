@@ -271,6 +271,15 @@ void ArmController::onJointState(const sensor_msgs::JointState& state) {
   }
 }
 
+bool ArmController::driverListening(const ros::Publisher& publisher) const {
+  // A message published before the driver's subscription is connected would be lost.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(settings_.state_timeout);
+  while (publisher.getNumSubscribers() == 0 && ros::ok() && ros::WallTime::now() < deadline) {
+    ros::WallDuration(0.005).sleep();
+  }
+  return publisher.getNumSubscribers() > 0;
+}
+
 bool ArmController::currentJoints(JointVector& q, double wait) {
   std::unique_lock<std::mutex> lock(state_mutex_);
   state_cv_.wait_for(lock, std::chrono::duration<double>(wait), [this] { return have_state_; });
@@ -386,8 +395,15 @@ rascal_msgs::MoveArmResult ArmController::runMove(const rascal_msgs::MoveArmGoal
   }
   const Trajectory& trajectory = planned.trajectory;
   const JointVector target = trajectory.goal();
+  if (!driverListening(arm_command_pub_)) {
+    result.code = rascal_msgs::MoveArmResult::TIMEOUT;
+    result.message = "no driver subscribes to /arm/joint_trajectory; is it running?";
+    return result;
+  }
   const ros::Time t0 = ros::Time::now();
-  arm_command_pub_.publish(toJointTrajectory(trajectory, settings_.command_period, t0));
+  const ros::WallTime wall0 = ros::WallTime::now();
+  // Stamp 0: the driver starts the trajectory when it arrives (no catching up on a late message).
+  arm_command_pub_.publish(toJointTrajectory(trajectory, settings_.command_period, ros::Time(0)));
 
   rascal_msgs::MoveArmFeedback feedback;
   ros::Time last_feedback;
@@ -429,7 +445,11 @@ rascal_msgs::MoveArmResult ArmController::runMove(const rascal_msgs::MoveArmGoal
       result.message = "arrived";
       return result;
     }
-    if (elapsed > trajectory.duration() + settings_.settle_timeout || silent) {
+    // Time out in sim time, but never sooner than settle_timeout of wall time: a simulator running
+    // many times faster than real time must not turn message latency into a TIMEOUT.
+    const bool late = elapsed > trajectory.duration() + settings_.settle_timeout &&
+                      (ros::WallTime::now() - wall0).toSec() > settings_.settle_timeout;
+    if (late || silent) {
       arm_command_pub_.publish(stopTrajectory(now));
       char text[200];
       std::snprintf(text, sizeof(text),
@@ -519,6 +539,7 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
     return result;
   }
   const bool closing = target < left;
+  const double left_at_start = left;
   auto command = [this](double position, double seconds) {
     trajectory_msgs::JointTrajectory msg;
     msg.header.stamp = ros::Time::now();
@@ -530,7 +551,13 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
     gripper_command_pub_.publish(msg);
   };
   const double stroke = settings_.gripper_stroke_time * std::fabs(target - left) / (kFingerMax - kFingerMin);
+  if (!driverListening(gripper_command_pub_)) {
+    result.code = rascal_msgs::GripperResult::TIMEOUT;
+    result.message = "no driver subscribes to /gripper/command; is it running?";
+    return result;
+  }
   const ros::Time t0 = ros::Time::now();
+  const ros::WallTime wall0 = ros::WallTime::now();
   command(target, stroke);
   rascal_msgs::GripperFeedback feedback;
   while (true) {
@@ -564,7 +591,12 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
             covered = true;
           }
         }
-        stalled = covered && hi - lo < kFingerStall;
+        // Only once the fingers have moved (the command has arrived), or after a full stroke's time.
+        const bool moved = std::fabs(left - left_at_start) > kFingerReached;
+        const double wall = (ros::WallTime::now() - wall0).toSec();
+        const double still_for = settings_.gripper_stroke_time + kStallWindow;
+        stalled = covered && hi - lo < kFingerStall &&
+                  (moved ? wall > kStallWindow : elapsed > still_for && wall > still_for);
       }
     }
     if (std::fabs(left - target) < kFingerReached || stalled) {
@@ -576,7 +608,8 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
       result.message = text;
       return result;
     }
-    if (elapsed > settings_.gripper_timeout) {
+    if (elapsed > settings_.gripper_timeout &&
+        (ros::WallTime::now() - wall0).toSec() > settings_.gripper_timeout) {
       result.code = rascal_msgs::GripperResult::TIMEOUT;
       result.message = "fingers still moving " + std::to_string(elapsed) + " s after the command";
       return result;

@@ -57,6 +57,8 @@ class ArmController {
   void onJointState(const sensor_msgs::JointState& msg);
   // Latest arm joints; waits up to the state timeout (wall time) for the first message.
   bool currentJoints(JointVector& q, double wait);
+  // Waits up to the state timeout (wall time) until the driver subscribes to `publisher`.
+  bool driverListening(const ros::Publisher& publisher) const;
 
   void executeMove(const rascal_msgs::MoveArmGoalConstPtr& goal);
   rascal_msgs::MoveArmResult runMove(const rascal_msgs::MoveArmGoal& goal);
