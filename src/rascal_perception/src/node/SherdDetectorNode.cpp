@@ -2,6 +2,7 @@
 
 #include <visualization_msgs/MarkerArray.h>
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,6 +14,7 @@ namespace rascal_perception {
 namespace {
 constexpr const char* kOpticalFrame = "camera_color_optical_frame";
 constexpr size_t kBuffer = 15;  ///< frames kept per stream (0.5 s at 30 Hz)
+constexpr double kPairSlop = 0.015;  ///< [s] colour and depth stamps closer than this are one frame
 
 [[noreturn]] void fail(const std::string& key, const std::string& why) {
   throw std::runtime_error("parameter " + key + ": " + why);
@@ -134,16 +136,20 @@ bool SherdDetectorNode::waitForFrame(const ros::Time& since, Frame& frame, std::
   while (ros::ok()) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      // the newest colour image at or after `since` that has a depth image with the same stamp
+      // the newest colour image at or after `since` with a depth image within kPairSlop of it
+      // (the simulator stamps both alike; a real aligned depth may be a few ms off)
       for (auto c = colours_.rbegin(); c != colours_.rend(); ++c) {
         if ((*c)->header.stamp < since) break;
+        double best = kPairSlop;
         for (const auto& d : depths_) {
-          if (d->header.stamp == (*c)->header.stamp) {
+          const double dt = std::fabs(((*c)->header.stamp - d->header.stamp).toSec());
+          if (dt <= best) {
+            best = dt;
             frame.colour = *c;
             frame.depth = d;
-            return true;
           }
         }
+        if (frame.colour) return true;
       }
     }
     if ((ros::Time::now() - since).toSec() > wait_s_ || (ros::WallTime::now() - wall_start).toSec() > 5.0 * wait_s_ + 2.0) {

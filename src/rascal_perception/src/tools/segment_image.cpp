@@ -1,6 +1,6 @@
 // segment_image: sherds and the scale bar in a photo (no ROS).
 //   segment_image <photo> [--background auto|<empty.jpg>] [--json out.json] [--png out.png]
-//                 [--bar-length 10] [--clusters 4]
+//                 [--mask foreground.png] [--bar-length 10] [--clusters 6]
 // Prints the JSON to stdout when --json is not given.
 #include <cmath>
 #include <cstdio>
@@ -19,7 +19,7 @@ namespace {
 int usage() {
   std::fprintf(stderr,
                "usage: segment_image <photo> [--background auto|<empty.jpg>] [--json out.json] [--png out.png]\n"
-               "                     [--bar-length cm] [--clusters k]\n");
+               "                     [--mask foreground.png] [--bar-length cm] [--clusters k]\n");
   return 2;
 }
 
@@ -93,7 +93,7 @@ cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
 
 int main(int argc, char** argv) {
   if (argc < 2) return usage();
-  std::string image = argv[1], background = "auto", json_path, png_path;
+  std::string image = argv[1], background = "auto", json_path, png_path, mask_path;
   PhotoSegmenter::Options options;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -106,6 +106,8 @@ int main(int argc, char** argv) {
         json_path = v;
       } else if (a == "--png") {
         png_path = v;
+      } else if (a == "--mask") {
+        mask_path = v;
       } else if (a == "--bar-length") {
         options.bar_length_cm = std::stod(v);
       } else if (a == "--clusters") {
@@ -128,6 +130,7 @@ int main(int argc, char** argv) {
     } else {
       std::ofstream(json_path) << text;
     }
+    if (!mask_path.empty() && !cv::imwrite(mask_path, r.foreground)) throw std::runtime_error("cannot write " + mask_path);
     if (!png_path.empty()) {
       cv::Mat bgr;
       cv::cvtColor(annotate(rgb, r), bgr, cv::COLOR_RGB2BGR);
