@@ -119,6 +119,9 @@ def print_summary(batch, recorder, outcome, wall_seconds):
     print("batch %s: %s — %d recorded, %d lost, %.1f s (%s), wall %.1f s" % (
         batch.context, outcome, batch.completed, batch.lost, sim,
         "%.1f s/sherd" % (sim / n) if n else "no sherds", wall_seconds))
+    for x, y in batch.unpickable:
+        print("left in the pickup area (could not be picked up): sherd at (%.3f, %.3f) m"
+              % (x, y))
     if batch.state_times:
         print("time per state (s): " + ", ".join(
             "%s %.1f" % kv for kv in sorted(batch.state_times.items(), key=lambda kv: -kv[1])))

@@ -73,6 +73,8 @@ class Batch:
         self.timings = Timings()
         self.state_times = {}  # state label -> seconds, for the summary and the benchmark
         self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
+        self.misses = {}  # rounded (x, y) -> pickups that failed there
+        self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
         self.pending: List[Observation] = []
         self.empty_surveys = 0
         self.completed = 0
@@ -265,6 +267,9 @@ class Survey(BatchState):
         for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size,
                               b.config["survey"]["step"]):
             _merge(found, b.survey_at(b.pickup, x, y))
+        # Sherds the gripper failed on again and again stay where they are, for a person.
+        found = [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD
+                                         for xy in b.unpickable)]
         if not found:
             b.empty_surveys += 1
             if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
@@ -304,6 +309,12 @@ class Pickup(BatchState):
                 break
             o = min(near, key=lambda s: s.distance_to(o.x, o.y))
         b.pending = []  # the area changed under us: survey again
+        key = (round(o.x, 2), round(o.y, 2))
+        b.misses[key] = b.misses.get(key, 0) + 1
+        if b.misses[key] >= 2:
+            b.unpickable.append((o.x, o.y))
+            b.event(None, "unpickable", "sherd at (%.3f, %.3f) m left in the pickup area after "
+                    "%d failed grasps" % (o.x, o.y, 2 * attempts))
         return "missed"
 
 
