@@ -560,6 +560,7 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
   const ros::WallTime wall0 = ros::WallTime::now();
   command(target, stroke);
   rascal_msgs::GripperFeedback feedback;
+  ros::Time last_feedback;
   while (true) {
     {
       std::unique_lock<std::mutex> lock(state_mutex_);
@@ -614,8 +615,11 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
       result.message = "fingers still moving " + std::to_string(elapsed) + " s after the command";
       return result;
     }
-    feedback.width = opening;
-    gripper_server_->publishFeedback(feedback);
+    if ((now - last_feedback).toSec() >= 0.05 || now < last_feedback) {
+      feedback.width = opening;
+      gripper_server_->publishFeedback(feedback);
+      last_feedback = now;
+    }
   }
 }
 
