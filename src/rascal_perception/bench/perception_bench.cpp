@@ -3,11 +3,15 @@
 // detect (plus the plane, measurement, grasps, order), on frames rendered by the simulator's
 // core (generated scenes, 6..10 sherds, lighting 0.3 .. 1.5 x). Run it on one core:
 //   taskset -c 0 perception_bench [frames]
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "../test/SimScenes.hpp"
 #include "rascal_perception/SherdDetector.hpp"
@@ -19,6 +23,13 @@ using Clock = std::chrono::steady_clock;
 namespace {
 double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
+/// CPU time of this thread [ms]: on a shared machine, wall time also counts other processes.
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
 void report(const char* what, std::vector<double> t) {
   std::sort(t.begin(), t.end());
   const double median = t[t.size() / 2];
@@ -29,8 +40,9 @@ void report(const char* what, std::vector<double> t) {
 
 int main(int argc, char** argv) {
   const int scenes = argc > 1 ? std::max(1, std::stoi(argv[1])) : 40;
+  cv::setNumThreads(1);  // one core: no OpenCV worker threads competing for it
   const int repeats = 5;
-  std::vector<double> seg, det;
+  std::vector<double> seg, det, seg_cpu, det_cpu;
   size_t sherds = 0;
   for (int i = 0; i < scenes; ++i) {
     const unsigned seed = 1000 + i;
@@ -44,19 +56,26 @@ int main(int argc, char** argv) {
     d.calibrate("pickup", cal.rgb, cal.depth, cal.view, 0.0);
     cv::Mat fg;
     for (int k = 0; k < repeats; ++k) {
+      const double c0 = cpuMs();
       auto t0 = Clock::now();
       d.segment("pickup", f.rgb, f.depth, f.view, 0.0, fg);
       auto t1 = Clock::now();
+      const double c1 = cpuMs();
       const DetectionResult r = d.detect("pickup", f.rgb, f.depth, f.view, 0.0);
       auto t2 = Clock::now();
+      const double c2 = cpuMs();
       seg.push_back(ms(t1 - t0));
       det.push_back(ms(t2 - t1));
+      seg_cpu.push_back(c1 - c0);
+      det_cpu.push_back(c2 - c1);
       if (k == 0) sherds += r.sherds.size();
     }
   }
   std::printf("perception bench: %d scenes x %d runs, %zu sherds detected (%.1f per frame)\n", scenes, repeats,
               sherds, static_cast<double>(sherds) / scenes);
-  report("segmentation (segment)", seg);
-  report("full detect (detect)", det);
+  report("segmentation (segment), wall", seg);
+  report("full detect (detect), wall", det);
+  report("segmentation (segment), CPU", seg_cpu);
+  report("full detect (detect), CPU", det_cpu);
   return 0;
 }
