@@ -70,16 +70,16 @@ TEST(Simulator, CaptureArrivesShutterPlusTransferLater) {
   EXPECT_EQ(sim.archival().image().cols, 400);
 }
 
-/// Gripper pointing down over (0.30, 0.20) with the fingertips 6 mm above the table.
-static JointVector overSherd() {
+/// Joints that put ee_gripper_link at (x, y, z) with the gripper pointing straight down.
+static JointVector pointingDownAt(double x, double y, double z) {
   JointVector best{};
   double best_err = 1e9;
-  const double waist = std::atan2(0.20, 0.30), r = std::hypot(0.30, 0.20);
+  const double waist = std::atan2(y, x), r = std::hypot(x, y);
   for (double sh = -0.5; sh < 1.5; sh += 0.005) {
     for (double el = -1.0; el < 1.6; el += 0.005) {
       JointVector q{waist, sh, el, 0, M_PI / 2 - sh - el, 0};
       const Eigen::Vector3d p = ArmKinematics::forward(q, 0.037)[kEeGripperLink].translation();
-      const double err = std::abs(std::hypot(p.x(), p.y()) - r) + std::abs(p.z() - 0.006);
+      const double err = std::abs(std::hypot(p.x(), p.y()) - r) + std::abs(p.z() - z);
       if (err < best_err) {
         best_err = err;
         best = q;
@@ -88,6 +88,9 @@ static JointVector overSherd() {
   }
   return best;
 }
+
+/// Gripper pointing down over (0.30, 0.20) with the fingertips 6 mm above the table.
+static JointVector overSherd() { return pointingDownAt(0.30, 0.20, 0.006); }
 
 /// Grasps a centred sherd (across its minor axis) and lifts it by 0.3 rad of shoulder.
 static void graspAndLift(Simulator& sim, const JointVector& start) {
@@ -119,6 +122,11 @@ TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
   const auto truth = sim.groundTruth()[0];
   EXPECT_TRUE(truth.held);
   EXPECT_GT(truth.pose.translation().z(), 0.03);
+  // stopping the fingers where they are (a stop, or a command to their position) is no open
+  sim.stopGripper();
+  sim.commandGripper(sim.fingerPosition());
+  for (int i = 0; i < 300; ++i) sim.step();
+  EXPECT_TRUE(sim.groundTruth()[0].held);
 }
 
 TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {
@@ -134,6 +142,106 @@ TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {
   EXPECT_LT(truth.pose.translation().z(), 0.03);
   EXPECT_LT(truth.linear_velocity.norm(), 1e-2);
   EXPECT_LT(sim.fingerPosition(), 0.0155);  // nothing left between the fingers
+}
+
+/// The scanned fragment (box 57.7 x 55.3 x 18.9 mm) on the scale pan, its box turned 45 degrees
+/// from the fingers: its corners wedge into the fully open fingers (box diagonal 80 mm > 74 mm),
+/// so the close stops at once and the sherd is held with the fingers at 0.037 m. The arm starts
+/// with ee_gripper_link 8 mm above the pan and lifts the sherd by 8 mm.
+static void wedgeOnTheScale(Simulator& sim, const WorldLayout& layout) {
+  Scenario sc;
+  SherdSpec s;
+  s.name = "fragment";
+  s.mesh_file = layout.data_dir + "/archaide_braccio_frag_1.stl";
+  s.density = 1900;
+  const double x = layout.scale.position.x(), y = layout.scale.position.y();
+  s.pose = {x, y, std::atan2(y, x) + M_PI / 4};
+  sc.sherds = {s};
+  sc.seed = 3;
+  sim.load(sc);
+  for (int i = 0; i < 20; ++i) sim.step();  // close before the fingers push it round
+  sim.commandGripper(0.015);
+  for (int i = 0; i < 800; ++i) sim.step();
+  ASSERT_TRUE(sim.groundTruth()[0].held);
+  ASSERT_GT(sim.fingerPosition(), 0.0365) << "not wedged wide open: the test lost its premise";
+  TrajectoryPoint p;
+  p.positions = pointingDownAt(x, y, layout.scale_surface_z + 0.016);
+  p.time_from_start = 1.0;
+  sim.commandArm(sim.time(), {p}, {true, true, true, true, true, true});
+  for (int i = 0; i < 1500; ++i) sim.step();
+  const auto truth = sim.groundTruth()[0];
+  ASSERT_TRUE(truth.held);
+  EXPECT_GT(truth.pose.translation().z() - truth.box_size.z() / 2, layout.scale_surface_z + 0.004);
+}
+
+/// Steps up to `seconds`; the sim time at which the sherd came to rest and stayed (-1 if never),
+/// and whether it was ever held meanwhile.
+static double stepUntilRest(Simulator& sim, double seconds, bool& ever_held) {
+  double rest_at = -1.0;
+  const double end = sim.time() + seconds;
+  while (sim.time() < end) {
+    sim.step();
+    const auto s = sim.groundTruth()[0];
+    ever_held = ever_held || s.held;
+    const bool still = s.linear_velocity.norm() < 1e-3 && s.angular_velocity.norm() < 1e-2;
+    if (!still) rest_at = -1.0;
+    else if (rest_at < 0) rest_at = sim.time();
+  }
+  return rest_at;
+}
+
+TEST(Simulator, FullyOpeningReleasesADiagonallyWedgedSherd) {
+  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
+  SimulatorOptions o = quiet();
+  o.initial_joints = pointingDownAt(layout.scale.position.x(), layout.scale.position.y(),
+                                    layout.scale_surface_z + 0.008);
+  Simulator sim(layout, o);
+  wedgeOnTheScale(sim, layout);
+  const double t0 = sim.time();
+  sim.commandGripper(0.037);  // the fingers are already at 0.037: the command alone lets go
+  sim.step();
+  EXPECT_FALSE(sim.groundTruth()[0].held);
+  bool ever_held = false;
+  const double rest_at = stepUntilRest(sim, 2.5, ever_held);
+  const auto s = sim.groundTruth()[0];
+  EXPECT_FALSE(ever_held);
+  ASSERT_GT(rest_at, 0.0) << "still moving";
+  EXPECT_LT(rest_at - t0, 2.0);
+  EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, layout.scale_surface_z, 0.003);
+}
+
+TEST(Simulator, OpeningPartlyReleasesAWedgedSherdOnTheScaleForGood) {
+  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
+  SimulatorOptions o = quiet();
+  o.initial_joints = pointingDownAt(layout.scale.position.x(), layout.scale.position.y(),
+                                    layout.scale_surface_z + 0.008);
+  Simulator sim(layout, o);
+  wedgeOnTheScale(sim, layout);
+  // the lead's sequence: open to 70.5 mm (less than the wedged 74 mm, so the fingers move in
+  // while the sherd is still between them), then fully
+  sim.commandGripper(0.03525);
+  sim.step();
+  EXPECT_FALSE(sim.groundTruth()[0].held);
+  bool ever_held = false;
+  stepUntilRest(sim, 0.5, ever_held);
+  EXPECT_FALSE(ever_held) << "re-attached without a new close";
+  sim.commandGripper(0.037);
+  const double rest_at = stepUntilRest(sim, 2.5, ever_held);
+  EXPECT_FALSE(ever_held);
+  EXPECT_GT(rest_at, 0.0);
+  ScaleReading r;
+  for (int i = 0; i < 1000; ++i) {
+    sim.step();
+    sim.takeScaleReading(r);
+  }
+  const auto s = sim.groundTruth()[0];
+  EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, layout.scale_surface_z, 0.003);
+  EXPECT_TRUE(r.stable);
+  EXPECT_NEAR(r.mass, s.mass, 1e-4) << "truth " << s.mass;
+  // the next close grasps it again
+  sim.commandGripper(0.015);
+  for (int i = 0; i < 800; ++i) sim.step();
+  EXPECT_TRUE(sim.groundTruth()[0].held);
 }
 
 TEST(Simulator, ScaleGlitchMakesReadingsUnstable) {

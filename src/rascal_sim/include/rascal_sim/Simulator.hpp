@@ -41,6 +41,8 @@ class Simulator {
  public:
   static constexpr double kBlurSpeed = 0.05;    ///< [rad/s] timing.md
   static constexpr double kMaxPayload = 0.25;   ///< [kg] timing.md
+  /// [m] per finger: a command this much more open than the last one is an open (1 mm opening).
+  static constexpr double kReleaseStep = 0.0005;
 
   Simulator(const WorldLayout& layout, const SimulatorOptions& options);
   /// Spawns the scenario's sherds and takes its lighting; remembered for reset().
@@ -52,7 +54,12 @@ class Simulator {
 
   void commandArm(double start_time, const std::vector<TrajectoryPoint>& points,
                   const std::array<bool, kArmJoints>& mask);
+  /// A target below the previous one closes (and may grasp what both fingers touch); one that
+  /// opens (at least kReleaseStep above the previous target and not where the fingers already
+  /// are, or at the fully open 0.037 m, or beyond the fingers) lets a held sherd go at once.
   void commandGripper(double finger_position);
+  /// Stops the fingers where they are; a held sherd stays held.
+  void stopGripper();
   const JointVector& jointPositions() const { return servos_.positions(); }
   const JointVector& jointVelocities() const { return servos_.velocities(); }
   double fingerPosition() const { return gripper_.position(); }
@@ -84,6 +91,8 @@ class Simulator {
 
  private:
   void updateGrasp();
+  /// Lets the held sherd go because the fingers open: it falls out of them under physics.
+  void releaseByOpening();
 
   WorldLayout layout_;
   SimulatorOptions options_;
@@ -102,6 +111,8 @@ class Simulator {
   double camera_fault_until_ = -1.0;
   // grasp bookkeeping
   double grasp_z_ = 0.0;
+  bool close_armed_ = false;     // a close was commanded since the last open: may grasp
+  bool open_requested_ = false;  // an open was commanded: the held sherd goes
   bool slip_armed_ = false;
   double slip_delay_ = 0.0, slip_lifted_since_ = -1.0;
   RenderOutput scratch_;

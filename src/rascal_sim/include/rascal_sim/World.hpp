@@ -41,6 +41,9 @@ class World {
   /// Replaces all sherds (throws std::runtime_error for a bad spec, naming the sherd).
   void spawn(const std::vector<SherdSpec>& sherds);
   void clearSherds();
+  /// Seeds ODE's (process-wide) random generator, with which QuickStep reorders its constraints:
+  /// the same seed and commands replay the same motion, whatever ran before in the process.
+  void seedSolver(unsigned long seed);
   /// Puts the arm at q / finger at once (start-up and reset).
   void placeArm(const JointVector& q, double finger);
   /// The arm pose the kinematic links must reach at the end of the next step.
@@ -57,6 +60,11 @@ class World {
   int held() const;
   /// Fingers and gripper pass through sherd i until `until` (a slipping sherd falls out).
   void ignoreGripperContacts(int sherd, double until);
+  /// The arm passes through sherd i until a step in which no arm box overlaps it any more (a
+  /// sherd let go while its box is wedged between the fingers falls out instead of sticking).
+  void ignoreGripperContactsWhileOverlapping(int sherd);
+  /// Ends every such pass-through (a new close touches whatever is between the fingers again).
+  void stopIgnoringOverlaps();
 
   size_t sherdCount() const;
   SherdState sherd(size_t i) const;

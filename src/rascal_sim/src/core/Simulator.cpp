@@ -24,9 +24,12 @@ Simulator::Simulator(const WorldLayout& layout, const SimulatorOptions& options)
 
 void Simulator::load(const Scenario& scenario) {
   world_.spawn(scenario.sherds);
+  world_.seedSolver(scenario.seed);
   scenario_ = scenario;
   rng_.seed(scenario.seed);
   slip_armed_ = false;
+  close_armed_ = false;
+  open_requested_ = false;
 }
 
 void Simulator::reset() {
@@ -35,9 +38,12 @@ void Simulator::reset() {
   servos_.reset(options_.initial_joints);
   gripper_.reset(options_.initial_finger);
   world_.placeArm(servos_.positions(), gripper_.position());
+  world_.seedSolver(scenario_.seed);
   rng_.seed(scenario_.seed);
   slip_armed_ = false;
   drop_next_grasp_ = false;
+  close_armed_ = false;
+  open_requested_ = false;
 }
 
 void Simulator::commandArm(double start_time, const std::vector<TrajectoryPoint>& points,
@@ -45,7 +51,24 @@ void Simulator::commandArm(double start_time, const std::vector<TrajectoryPoint>
   servos_.setTrajectory(time(), start_time, points, mask);
 }
 
-void Simulator::commandGripper(double finger_position) { gripper_.setTarget(finger_position); }
+void Simulator::commandGripper(double finger_position) {
+  const double previous = gripper_.target(), q = gripper_.position();
+  gripper_.setTarget(finger_position);
+  const double target = gripper_.target();
+  if (target < previous - 1e-6 && target < q - 1e-6) {
+    close_armed_ = true;
+    world_.stopIgnoringOverlaps();
+  } else if (target > previous + kReleaseStep && std::abs(target - q) > 1e-4) {
+    // an open, even to less than where a sherd wedged the fingers (not a stop where they are)
+    close_armed_ = false;
+    open_requested_ = true;
+  } else if (target >= ArmKinematics::kFingerMax - 1e-6) {
+    close_armed_ = false;
+    open_requested_ = true;
+  }
+}
+
+void Simulator::stopGripper() { gripper_.setTarget(gripper_.position()); }
 
 void Simulator::step() {
   const double dt = options_.physics_dt;
@@ -62,12 +85,24 @@ void Simulator::step() {
   if (archival_.update(time(), world_.armPose())) archival_.deliver(time(), renderArchival());
 }
 
+void Simulator::releaseByOpening() {
+  const int held = world_.held();
+  world_.release();
+  // a sherd whose box is wedged between the fingers (grasped across its corners) would stay
+  // stuck there by contact friction: it passes through the arm until it is clear of it
+  world_.ignoreGripperContactsWhileOverlapping(held);
+  slip_armed_ = false;
+  close_armed_ = false;
+  open_requested_ = false;
+}
+
 void Simulator::updateGrasp() {
   const int held = world_.held();
   if (held >= 0) {
-    if (gripper_.opening()) {
-      world_.release();
-      slip_armed_ = false;
+    // the fixed joint holds only while the fingers press on the sherd: any open lets it go,
+    // and it never stays attached to fingers commanded fully open
+    if (open_requested_ || gripper_.opening() || gripper_.target() >= ArmKinematics::kFingerMax - 1e-6) {
+      releaseByOpening();
       return;
     }
     if (slip_armed_) {
@@ -83,8 +118,11 @@ void Simulator::updateGrasp() {
     }
     return;
   }
+  open_requested_ = false;
   const FingerContacts& fc = world_.fingerContacts();
-  if (!(gripper_.target() < gripper_.position() - 1e-6) || fc.left < 0 || fc.left != fc.right) return;
+  // only a close commanded since the last open grasps (an open to less than where a wedged
+  // sherd held the fingers moves them inwards, but must not grasp it again)
+  if (!close_armed_ || !gripper_.closing() || fc.left < 0 || fc.left != fc.right) return;
   const int i = fc.left;
   world_.hold(i);
   const SherdState s = world_.sherd(i);

@@ -54,6 +54,8 @@ struct World::Impl {
     dGeomID geom = nullptr;
     GeomTag tag{GeomTag::kSherd, 0};
     double ignore_until = -1.0;
+    bool ignore_overlap = false;  // arm contacts ignored until no arm box overlaps the sherd
+    bool overlap_seen = false;    // an arm box overlapped it in this step
   };
 
   dWorldID world = nullptr;
@@ -110,6 +112,11 @@ struct World::Impl {
     if (t1->kind == GeomTag::kSherd && arm2) {
       const Sherd& s = *sherds[t1->index];
       if (t1->index == held || time < s.ignore_until) return;
+    }
+    if (t1->kind == GeomTag::kSherd && arm2 && sherds[t1->index]->ignore_overlap) {
+      dContactGeom g;
+      if (dCollide(o1, o2, 1, &g, sizeof(dContactGeom)) > 0) sherds[t1->index]->overlap_seen = true;
+      return;
     }
     if (t1->kind == GeomTag::kSherd && (arm2 || t2->kind == GeomTag::kPlatform) && !dBodyIsEnabled(b1)) {
       dBodyEnable(b1);  // the arm or the pan wakes a sleeping sherd
@@ -319,6 +326,8 @@ void World::clearSherds() {
   w.sherds.clear();
 }
 
+void World::seedSolver(unsigned long seed) { dRandSetSeed(seed); }
+
 void World::spawn(const std::vector<SherdSpec>& sherds) {
   dAllocateODEDataForThread(dAllocateMaskAll);  // spawn may come from a service thread
   clearSherds();
@@ -375,7 +384,9 @@ void World::step(double dt) {
   w.time = time_;
   w.setLinkBodies(true, dt);
   w.contacts_now = FingerContacts();
+  for (auto& s : w.sherds) s->overlap_seen = false;
   dSpaceCollide(w.space, &w, &Impl::nearCallback);
+  for (auto& s : w.sherds) s->ignore_overlap = s->ignore_overlap && s->overlap_seen;
   dWorldQuickStep(w.world, dt);
   dJointGroupEmpty(w.contact_group);
   w.setLinkBodies(false, dt);
@@ -417,6 +428,16 @@ int World::held() const { return impl_->held; }
 
 void World::ignoreGripperContacts(int sherd, double until) {
   if (sherd >= 0 && sherd < static_cast<int>(impl_->sherds.size())) impl_->sherds[sherd]->ignore_until = until;
+}
+
+void World::ignoreGripperContactsWhileOverlapping(int sherd) {
+  if (sherd < 0 || sherd >= static_cast<int>(impl_->sherds.size())) return;
+  impl_->sherds[sherd]->ignore_overlap = true;
+  impl_->sherds[sherd]->overlap_seen = true;
+}
+
+void World::stopIgnoringOverlaps() {
+  for (auto& s : impl_->sherds) s->ignore_overlap = false;
 }
 
 size_t World::sherdCount() const { return impl_->sherds.size(); }

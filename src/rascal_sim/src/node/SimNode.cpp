@@ -240,7 +240,7 @@ void SimNode::onGripperCommand(const trajectory_msgs::JointTrajectory::ConstPtr&
   }
   std::lock_guard<std::mutex> lk(mutex_);
   if (msg->points.empty()) {
-    sim_->commandGripper(sim_->fingerPosition());  // stop where the fingers are
+    sim_->stopGripper();  // stop where the fingers are (a held sherd stays held)
     return;
   }
   if (idx < 0 || msg->points.back().positions.size() <= static_cast<size_t>(idx)) {
