@@ -113,9 +113,11 @@ void BackgroundModel::cluster(const cv::Mat& hsv, const cv::Mat& ignore) {
   if (k < 1) throw std::invalid_argument("BackgroundModel::learn: the image is too dark to learn from");
   cv::Mat data(static_cast<int>(samples.size()), 3, CV_32F, samples.data());
   cv::Mat labels, centres;
+  const uint64_t saved_rng = cv::theRNG().state;  // seeded k-means, without touching others' RNG
   cv::theRNG().state = options_.seed;
   cv::kmeans(data, k, labels, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4), 3,
              cv::KMEANS_PP_CENTERS, centres);
+  cv::theRNG().state = saved_rng;
   struct Acc { double c = 0, s = 0, sat = 0, v = 0; int n = 0; };
   std::vector<Acc> acc(k);
   for (size_t i = 0; i < hsv_samples.size(); ++i) {

@@ -27,10 +27,12 @@ cv::Mat PhotoSegmenter::foreground(const cv::Mat& rgb, const cv::Mat& background
   }
   const int k = background.empty() ? options_.clusters : 1;
   cv::Mat labels, centres;
+  const uint64_t saved_rng = cv::theRNG().state;  // seeded k-means, without touching others' RNG
   cv::theRNG().state = options_.seed;
   cv::kmeans(cv::Mat(static_cast<int>(samples.size()), 3, CV_32F, samples.data()), k, labels,
              cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4), 3, cv::KMEANS_PP_CENTERS,
              centres);
+  cv::theRNG().state = saved_rng;
   std::vector<int> count(k, 0);
   for (int i = 0; i < labels.rows; ++i) ++count[labels.at<int>(i)];
   const int largest = static_cast<int>(std::max_element(count.begin(), count.end()) - count.begin());

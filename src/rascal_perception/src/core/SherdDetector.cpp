@@ -1,6 +1,7 @@
 #include "rascal_perception/SherdDetector.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <opencv2/imgproc.hpp>
 
 #include "rascal_perception/SherdSelector.hpp"
@@ -151,7 +152,11 @@ void SherdDetector::warpPriors(const Station& s, const CameraView& view, double 
 std::vector<Blob> SherdDetector::segment(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
                                          const CameraView& view, double surface_z, cv::Mat& foreground,
                                          SegmentationStats* stats) {
-  const Station& s = stations_.at(station);
+  auto it = stations_.find(station);
+  if (it == stations_.end()) {
+    throw std::logic_error("SherdDetector::segment: station " + station + " has no background model");
+  }
+  const Station& s = it->second;
   warpPriors(s, view, surface_z, allowed_, fixture_);
   const double ppm = pixelsPerMetre(view, surface_z);
   SegmentationOptions o;
