@@ -3,7 +3,9 @@
 //  - centres: from the photo viewed at full size (approximate, +-10 px);
 //  - px/cm: the bar cropped and magnified 4x with a pixel ruler (ticks every 10 px). img005: bar
 //    edges at x = 407 and 633 (226 px / 10 cm), chequer edges every 22.5 px -> 22.55 px/cm;
-//    img114: bar edges at x = 443.75 and 635 (191.25 px), chequer edges every 19.15 px -> 19.1 px/cm.
+//    img114: bar edges at x = 443.75 and 635 (191.25 px), chequer edges every 19.15 px -> 19.1 px/cm;
+//    img071 (6x crop, ticks every 5 px): bar edges at x = 385.8 and 514.2 (128.4 px), chequer
+//    edges every 12.83 px -> 12.84 px/cm.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -67,6 +69,15 @@ TEST(PhotoSegmenter, SgraffitoPhotoSeparateSherdsOnceAndTheBar) {
 // blob; their dark crack is closed over and there is no neck to split at.
 TEST(PhotoSegmenter, DISABLED_SgraffitoPhotoSplitsTheSherdsLyingEdgeToEdge) {
   check("img114SG101831.jpg", kSgraffito, 19.1);
+}
+
+TEST(PhotoSegmenter, SmallBarWhoseChequerMergesWithItsWhiteRow) {
+  // 50 sherds and a bar only 128 px long: its white squares and row touch after the closing
+  const cv::Mat rgb = photo("img071DSC02209.jpg");
+  ASSERT_FALSE(rgb.empty());
+  const PhotoResult r = PhotoSegmenter(PhotoSegmenter::Options()).segment(rgb);
+  ASSERT_TRUE(r.bar.found);
+  EXPECT_NEAR(r.bar.px_per_cm, 12.84, 0.03 * 12.84);
 }
 
 TEST(PhotoSegmenter, NoBarNoScale) {

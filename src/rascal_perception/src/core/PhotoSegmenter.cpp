@@ -144,6 +144,59 @@ ScaleBar PhotoSegmenter::findBar(const cv::Mat& rgb, std::vector<Blob>& blobs) c
   for (size_t i : squares) {
     if (half || i == static_cast<size_t>(index)) blobs.erase(blobs.begin() + static_cast<long>(i));
   }
+  // Refine the length from the image: the bar (black and white) is brighter than the cloth
+  // around it, so the mean value across the bar's width, along its axis, steps up at both ends.
+  const double estimate = bar.px_per_cm * options_.bar_length_cm;
+  const double half_width = half ? lo : 0.5 * lo;  // the bar is 2 cm wide; the white row 1 cm
+  const cv::Point2f across(-axis.y, axis.x);
+  const cv::Point2f centre = bar.box.center;
+  const int reach = static_cast<int>(1.5 * estimate);
+  std::vector<double> profile(2 * reach + 1, 0.0);
+  for (int t = -reach; t <= reach; ++t) {
+    double sum = 0.0;
+    int n = 0;
+    for (double k = -0.8 * half_width; k <= 0.8 * half_width; k += 1.0) {
+      const cv::Point2f p = centre + static_cast<float>(t) * axis + static_cast<float>(k) * across;
+      const int x = cvRound(p.x), y = cvRound(p.y);
+      if (x < 0 || y < 0 || x >= hsv.cols || y >= hsv.rows) continue;
+      sum += hsv.at<cv::Vec3b>(y, x)[2];
+      ++n;
+    }
+    profile[t + reach] = n ? sum / n : 0.0;
+  }
+  std::vector<double> inside, outside;
+  for (int t = -reach; t <= reach; ++t) {
+    if (std::abs(t) < 0.3 * estimate) inside.push_back(profile[t + reach]);
+    if (std::abs(t) > 0.7 * estimate) outside.push_back(profile[t + reach]);
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  if (!inside.empty() && !outside.empty()) {
+    const double level = 0.5 * (median(inside) + median(outside));
+    // walk out from the middle of the bar to the first crossing on each side (sub-pixel)
+    int mid = 0;  // the bar position nearest the box centre
+    for (int d = 0; d <= reach; ++d) {
+      if (profile[reach + d] > level) {
+        mid = d;
+        break;
+      }
+      if (profile[reach - d] > level) {
+        mid = -d;
+        break;
+      }
+    }
+    auto edge = [&](int dir) {
+      for (int t = mid; std::abs(t + dir) <= reach; t += dir) {
+        const double a = profile[t + reach], b = profile[t + dir + reach];
+        if (a > level && b <= level) return t + dir * (a - level) / (a - b);
+      }
+      return static_cast<double>(dir * reach);
+    };
+    const double length = edge(+1) - edge(-1);
+    if (length > 0.8 * estimate && length < 1.25 * estimate) bar.px_per_cm = length / options_.bar_length_cm;
+  }
   return bar;
 }
 
