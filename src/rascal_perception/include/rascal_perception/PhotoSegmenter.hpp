@@ -38,6 +38,7 @@ class PhotoSegmenter {
     double bar_length_cm = 10.0;
     double bar_aspect_min = 3.5, bar_aspect_max = 7.0;
     double min_side_fraction = 0.012;   ///< blobs with a shorter side (x image width) are noise
+    double max_side_fraction = 0.35;    ///< blobs with a longer side (x image width) are background
     double split_min_neck = 0.75;       ///< see PerceptionConfig::split_min_neck
     unsigned seed = 1;
   };

@@ -264,6 +264,7 @@ PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& backgroun
   r.foreground = foreground(rgb, background);
   SegmentationOptions o;
   o.min_side_px = options_.min_side_fraction * rgb.cols;
+  o.max_side_px = options_.max_side_fraction * std::max(rgb.cols, rgb.rows);
   o.border_margin = 2;
   o.split_min_neck = options_.split_min_neck;
   std::vector<Blob> blobs = SherdSegmenter().blobs(r.foreground, o);
