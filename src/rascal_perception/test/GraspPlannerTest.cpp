@@ -58,17 +58,3 @@ TEST(GraspPlanner, ScoresCrowdedSherdsLower) {
   EXPECT_LT(v[0].score, v[2].score);
   EXPECT_NEAR(v[2].score, 1.0, 1e-9);
 }
-
-TEST(SherdSelector, OrdersByPolicy) {
-  std::vector<SherdDetection> v{sherd(0.30, 0.25, 0, 0.05, 0.04, 0.01), sherd(0.10, 0.25, 0, 0.07, 0.05, 0.01),
-                                sherd(0.16, 0.25, 0, 0.04, 0.035, 0.01)};
-  GraspPlanner(PerceptionConfig()).score(v);
-  SherdSelector::order(v, SelectionPolicy::kNearest, Eigen::Vector2d(0.15, 0.25));
-  EXPECT_NEAR(v[0].centre.x(), 0.16, 1e-12);
-  SherdSelector::order(v, SelectionPolicy::kLargest, Eigen::Vector2d::Zero());
-  EXPECT_NEAR(v[0].centre.x(), 0.10, 1e-12);
-  SherdSelector::order(v, SelectionPolicy::kMostIsolated, Eigen::Vector2d::Zero());
-  EXPECT_NEAR(v[0].centre.x(), 0.30, 1e-12);
-  EXPECT_THROW(parseSelectionPolicy("random"), std::invalid_argument);
-  EXPECT_EQ(parseSelectionPolicy("most_isolated"), SelectionPolicy::kMostIsolated);
-}

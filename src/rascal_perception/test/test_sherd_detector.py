@@ -172,3 +172,6 @@ def test_detects_the_demo_sherds_in_base_link(ros_master, rosrun):
         assert len(s["outline"]) >= 3 and s["area"] > 0 and 0 < s["score"] <= 1
     markers = ros_master.run(["rostopic", "echo", "-n", "1", "/rascal/detections"], timeout=30).stdout
     assert 'ns: "sherds"' in markers and 'ns: "grasps"' in markers and 'ns: "labels"' in markers
+    image = ros_master.run(["rostopic", "echo", "-n", "1", "--noarr", "/rascal/perception/annotated"],
+                           timeout=30).stdout
+    assert 'encoding: "rgb8"' in image and "width: 640" in image
