@@ -132,7 +132,8 @@ def grasp(arm, gripper):
     empty_open = gripper.open()
     arm.move_to(Arm.top_down(0.30, 0.10, 0.15))  # over the bare table
     empty = gripper.close()
-    return {"held": held.holding, "held_width": held.width, "empty": empty.holding,
+    return {"held": held.holding, "held_width": held.width, "held_seconds": held.duration,
+            "empty": empty.holding,
             "empty_width": empty.width, "open_width": empty_open.width,
             "sherd_width": s.width, "sherd": s.name}
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -23,6 +24,8 @@ constexpr double kAtRest = 0.02;           // [rad/s] joint speed counted as "at
 constexpr double kFingerReached = 0.0005;  // [m]
 constexpr double kFingerStall = 0.0001;    // [m] finger motion over kStallWindow that means stopped
 constexpr double kStallWindow = 0.1;       // [s]
+constexpr double kFingerStopped = 1e-4;    // [m/s] reported finger speed that means stopped
+constexpr std::size_t kStoppedSamples = 3; // consecutive /joint_states messages
 constexpr double kStateSilence = 2.0;      // [s] wall time without /joint_states during a move
 
 [[noreturn]] void badParameter(const std::string& key, const std::string& why) {
@@ -254,8 +257,10 @@ void ArmController::onJointState(const sensor_msgs::JointState& state) {
     const auto finger = positions_.find("left_finger");
     if (finger != positions_.end()) {
       const double t = ros::Time::now().toSec();
-      finger_history_.emplace_back(t, finger->second);
-      while (finger_history_.size() > 2 && finger_history_.front().first < t - 1.0) {
+      const auto v = velocities.find("left_finger");
+      finger_history_.push_back({t, finger->second,
+                                 v != velocities.end() ? v->second : std::numeric_limits<double>::quiet_NaN()});
+      while (finger_history_.size() > 2 && finger_history_.front().t < t - 1.0) {
         finger_history_.pop_front();
       }
     }
@@ -580,20 +585,29 @@ rascal_msgs::GripperResult ArmController::runGripper(const rascal_msgs::GripperG
     bool stalled = false;
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
-      if (!finger_history_.empty() && elapsed > 1.5 * kStallWindow) {
-        const double t_now = finger_history_.back().first;
-        double lo = finger_history_.back().second, hi = lo;
+      // Only once the fingers have moved (the command has arrived), or after a full stroke's time.
+      const bool moved = std::fabs(left - left_at_start) > kFingerReached;
+      // Fast: the driver's finger velocity has been zero for the last few messages.
+      if (moved && finger_history_.size() >= kStoppedSamples) {
+        bool stopped = true;
+        for (auto it = finger_history_.end() - kStoppedSamples; it != finger_history_.end(); ++it) {
+          stopped = stopped && std::fabs(it->velocity) < kFingerStopped;  // false for NaN
+        }
+        stalled = stopped;
+      }
+      // Slow: the finger position has not changed over the stall window.
+      if (!stalled && !finger_history_.empty() && elapsed > 1.5 * kStallWindow) {
+        const double t_now = finger_history_.back().t;
+        double lo = finger_history_.back().position, hi = lo;
         bool covered = false;
-        for (const auto& h : finger_history_) {
-          if (h.first >= t_now - kStallWindow) {
-            lo = std::min(lo, h.second);
-            hi = std::max(hi, h.second);
+        for (const FingerSample& h : finger_history_) {
+          if (h.t >= t_now - kStallWindow) {
+            lo = std::min(lo, h.position);
+            hi = std::max(hi, h.position);
           } else {
             covered = true;
           }
         }
-        // Only once the fingers have moved (the command has arrived), or after a full stroke's time.
-        const bool moved = std::fabs(left - left_at_start) > kFingerReached;
         const double wall = (ros::WallTime::now() - wall0).toSec();
         const double still_for = settings_.gripper_stroke_time + kStallWindow;
         stalled = covered && hi - lo < kFingerStall &&

@@ -84,7 +84,12 @@ class ArmController {
   std::map<std::string, double> positions_;
   std::map<std::string, double> velocities_;
   ros::WallTime last_state_wall_;
-  std::deque<std::pair<double, double>> finger_history_;  // (time [s], left_finger [m])
+  struct FingerSample {
+    double t;         // [s] ROS time of arrival
+    double position;  // [m] left_finger
+    double velocity;  // [m/s] left_finger, NaN when the driver sends none
+  };
+  std::deque<FingerSample> finger_history_;
   bool have_state_ = false;
 
   ros::Subscriber joint_state_sub_;
