@@ -8,6 +8,7 @@ plain ActionClient and a per-goal event set from the transition callback itself,
 transition can be lost. It offers the SimpleActionClient methods the clients use.
 """
 import threading
+import time
 
 
 class GoalRunner:
@@ -19,7 +20,19 @@ class GoalRunner:
         self._done = threading.Event()
 
     def wait_for_server(self, timeout) -> bool:
-        return self._client.wait_for_server(timeout)
+        """Waits up to `timeout` (rospy.Duration or seconds) of WALL time. actionlib measures its
+        own timeout in ROS time, which under use_sim_time starts at 0 and then jumps to the
+        simulator's clock (or races ahead of the wall clock), so it can give up at once."""
+        import rospy
+        seconds = timeout.to_sec() if hasattr(timeout, "to_sec") else float(timeout)
+        deadline = time.monotonic() + seconds
+        while not rospy.is_shutdown():
+            if self._client.wait_for_server(rospy.Duration(0.02)):
+                return True
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.01)
+        return False
 
     def send_goal(self, goal):
         done = threading.Event()
