@@ -49,12 +49,15 @@ class GoalRunner:
         """True when the goal finished; `timeout` (rospy.Duration) 0 = no limit."""
         import rospy
         seconds = timeout.to_sec()
-        deadline = None if seconds <= 0.0 else rospy.get_time() + seconds
+        start = None  # ROS time is 0 until a simulator's first /clock arrives
         while not rospy.is_shutdown():
             if self._done.wait(0.05):
                 return True
-            if deadline is not None and rospy.get_time() > deadline:
-                return False
+            now = rospy.get_time()
+            if seconds > 0.0 and now > 0.0:
+                start = now if start is None else start
+                if now - start > seconds:
+                    return False
         return self._done.is_set()
 
     def get_result(self):
