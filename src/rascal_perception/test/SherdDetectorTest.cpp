@@ -215,7 +215,12 @@ TEST(SherdDetector, SplitsTouchingPairs) {
           }
         }
       }
-      if (found == 2) ++split;
+      if (found == 2) {
+        ++split;
+      } else {
+        std::printf("not split: seed %u, %s + %s\n", seed, f.truth[i].name.c_str(), f.truth[i + 1].name.c_str());
+        save("touching_unsplit_" + std::to_string(seed), f, r);
+      }
     }
   }
   std::printf("touching pairs: %d of %d split\n", split, pairs);
