@@ -264,6 +264,12 @@ def config_from_dict(data, source="config/rascal.yaml", workspace=".") -> Config
     per.string("selection_policy", choices=SELECTION_POLICIES)
     dmin = per.number("depth_min", 0.05, 2.0, "metres")
     per.number("depth_max", dmin, 10.0, "metres (> perception.depth_min)")
+    per.number("min_sherd_height", 0.0, 0.02, "metres")
+    per.number("split_min_neck", 0.1, 1.0)
+    per.number("grasp_height_fraction", 0.1, 1.0)
+    per.number("grasp_tip_clearance", 0.0, 0.05, "metres")
+    per.number("frame_wait", 0.05, 10.0, "seconds")
+    per.number("refresh_period", 0.0, 3600.0, "seconds (0 = never)")
     per.done()
 
     scale = top.section("scale")
