@@ -276,3 +276,82 @@ TEST(Simulator, CameraTimeoutFaultAnswersOnlyAfterItsDuration) {
   ASSERT_TRUE(sim.triggerCapture(why)) << why;
   EXPECT_EQ(sim.archival().state(), ArchivalCamera::State::kShutter);
 }
+
+/// small_3's sherd_02 (the scanned fragment, box 57.7 x 55.3 x 18.9 mm) on the table, its box
+/// turned 45 degrees from the fingers, which are open to 70.5 mm: the close stalls at once on the
+/// box corners and the sherd is held and lifted 3 cm; an injected drop lets it go. With
+/// `stop_while_held`, the arm controller's stop (a command to where the fingers are, as on a
+/// cancel, and an empty trajectory) comes while it is held. Returns the sim time of the release.
+static double dropAWedgedSherd(Simulator& sim, bool stop_while_held) {
+  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
+  const double x = 0.30, y = 0.20;
+  Scenario sc;
+  SherdSpec s;
+  s.name = "sherd_02";
+  s.mesh_file = layout.data_dir + "/archaide_braccio_frag_1.stl";
+  s.density = 1900;
+  s.pose = {x, y, std::atan2(y, x) + M_PI / 4};
+  sc.sherds = {s};
+  sc.seed = 3;
+  sim.load(sc);
+  std::string message;
+  EXPECT_TRUE(sim.injectFault(static_cast<int>(Fault::kDropNextGrasp), 0.0, message));
+  for (int i = 0; i < 20; ++i) sim.step();
+  sim.commandGripper(0.015);
+  for (int i = 0; i < 800; ++i) sim.step();
+  EXPECT_TRUE(sim.groundTruth()[0].held);
+  EXPECT_GT(sim.fingerPosition(), 0.034) << "not wedged: the test lost its premise";
+  if (stop_while_held) {
+    sim.commandGripper(sim.fingerPosition());
+    sim.stopGripper();
+    for (int i = 0; i < 100; ++i) sim.step();
+    EXPECT_TRUE(sim.groundTruth()[0].held) << "a stop is no open";
+  }
+  TrajectoryPoint p;
+  p.positions = pointingDownAt(x, y, 0.038);
+  p.time_from_start = 1.0;
+  sim.commandArm(sim.time(), {p}, {true, true, true, true, true, true});
+  while (sim.time() < 6.0) {
+    sim.step();
+    if (!sim.groundTruth()[0].held) return sim.time();
+  }
+  return -1.0;
+}
+
+static SimulatorOptions overTheFragment() {
+  SimulatorOptions o = quiet();
+  o.initial_joints = pointingDownAt(0.30, 0.20, 0.008);
+  o.initial_finger = 0.03525;
+  return o;
+}
+
+TEST(Simulator, FingersGoOnClosingWhenAWedgedSherdIsDropped) {
+  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), overTheFragment());
+  const double released_at = dropAWedgedSherd(sim, false);
+  ASSERT_GT(released_at, 0.0) << "the sherd was never let go";
+  while (sim.time() < released_at + 1.0) sim.step();
+  EXPECT_LT(sim.fingerPosition(), 0.016) << "the fingers stayed open after the sherd went";
+  EXPECT_FALSE(sim.groundTruth()[0].held);
+  EXPECT_LT(sim.groundTruth()[0].pose.translation().z(), 0.03);
+}
+
+TEST(Simulator, AStopWhileSqueezingKeepsTheCloseWhenTheSherdGoes) {
+  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), overTheFragment());
+  const double released_at = dropAWedgedSherd(sim, true);
+  ASSERT_GT(released_at, 0.0) << "the sherd was never let go";
+  while (sim.time() < released_at + 1.0) sim.step();
+  EXPECT_LT(sim.fingerPosition(), 0.016) << "the fingers stayed open after the sherd went";
+  EXPECT_FALSE(sim.groundTruth()[0].held);
+  EXPECT_LT(sim.groundTruth()[0].pose.translation().z(), 0.03);
+}
+
+TEST(Simulator, AStopWithNothingBetweenTheFingersStopsThem) {
+  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());
+  sim.commandGripper(0.015);
+  for (int i = 0; i < 100; ++i) sim.step();
+  sim.stopGripper();
+  const double stopped = sim.fingerPosition();
+  EXPECT_LT(stopped, 0.0355);
+  for (int i = 0; i < 300; ++i) sim.step();
+  EXPECT_NEAR(sim.fingerPosition(), stopped, 1e-9);
+}

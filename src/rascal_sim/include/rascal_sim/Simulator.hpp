@@ -58,7 +58,10 @@ class Simulator {
   /// opens (at least kReleaseStep above the previous target and not where the fingers already
   /// are, or at the fully open 0.037 m, or beyond the fingers) lets a held sherd go at once.
   void commandGripper(double finger_position);
-  /// Stops the fingers where they are; a held sherd stays held.
+  /// Stops the fingers where they are; a held sherd stays held. While the fingers squeeze a
+  /// sherd (held, or pressed by both fingers) after a close, a stop (this, or a command to where
+  /// the fingers are) keeps the close target, as the PWM-mode servo keeps squeezing: when the
+  /// sherd slips out, is dropped or leaves the fingers, they go on closing.
   void stopGripper();
   const JointVector& jointPositions() const { return servos_.positions(); }
   const JointVector& jointVelocities() const { return servos_.velocities(); }
@@ -91,6 +94,8 @@ class Simulator {
 
  private:
   void updateGrasp();
+  /// A close is under way and a sherd is held or pressed by both fingers.
+  bool squeezing() const;
   /// Lets the held sherd go because the fingers open: it falls out of them under physics.
   void releaseByOpening();
 

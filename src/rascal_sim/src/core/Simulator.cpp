@@ -53,6 +53,7 @@ void Simulator::commandArm(double start_time, const std::vector<TrajectoryPoint>
 
 void Simulator::commandGripper(double finger_position) {
   const double previous = gripper_.target(), q = gripper_.position();
+  const bool squeezed = squeezing();
   gripper_.setTarget(finger_position);
   const double target = gripper_.target();
   if (target < previous - 1e-6 && target < q - 1e-6) {
@@ -65,10 +66,22 @@ void Simulator::commandGripper(double finger_position) {
   } else if (target >= ArmKinematics::kFingerMax - 1e-6) {
     close_armed_ = false;
     open_requested_ = true;
+  } else if (target > previous && squeezed) {
+    gripper_.setTarget(previous);  // a stop where a squeezed sherd holds the fingers: keeps squeezing
   }
 }
 
-void Simulator::stopGripper() { gripper_.setTarget(gripper_.position()); }
+void Simulator::stopGripper() {
+  if (!squeezing()) gripper_.setTarget(gripper_.position());
+}
+
+bool Simulator::squeezing() const {
+  // PWM mode: the servo keeps its closing effort on an object between the fingers, so a stop
+  // there does not end the close; when the object goes, the fingers go on to the close target
+  if (!close_armed_ || !gripper_.closing()) return false;
+  const FingerContacts& fc = world_.fingerContacts();
+  return world_.held() >= 0 || (fc.left >= 0 && fc.left == fc.right);
+}
 
 void Simulator::step() {
   const double dt = options_.physics_dt;
