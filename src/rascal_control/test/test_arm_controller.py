@@ -166,18 +166,24 @@ def test_joint_states_drive_fk_and_tf(ros_master, rosrun):
 @requires_sim
 class TestAgainstTheSimulator:
     @pytest.fixture
-    def rig(self, ros_master, rosrun):
+    def rig(self, ros_master, rosrun, tmp_path):
         ros_master.run(["rosparam", "load", CONFIG])
         ros_master.run(["rosparam", "set", "/use_sim_time", "true"])
         ros_master.run(["rosparam", "set", "/simulator/real_time_factor", "0.0"])
         ros_master.run(["rosparam", "set", "/simulator/wrist_camera", "false"])
-        rosrun("rascal_sim", "sim")
+        self.logs = [tmp_path / "sim.log", tmp_path / "arm_controller.log"]
+        rosrun("rascal_sim", "sim", stdout=open(self.logs[0], "w"))
         wait_for(ros_master, "topic", "/joint_states")
-        start_controller(ros_master, rosrun)
+        rosrun("rascal_control", "arm_controller", stdout=open(self.logs[1], "w"))
+        wait_for(ros_master, "service", "/rascal/arm/compute_fk")
         return ros_master
 
     def client(self, rig, scenario):
-        return run_client(rig, scenario)
+        out = run_client(rig, scenario)
+        if "error" in out and scenario not in ("unreachable", "collision"):
+            for log in self.logs:  # the nodes' own words, to see why
+                print("==== %s\n%s" % (log.name, log.read_text()[-3000:]))
+        return out
 
     def test_pose_goal_arrives_within_2_mm(self, rig):
         out = self.client(rig, "pose_goal")

@@ -256,8 +256,12 @@ void ArmController::onJointState(const sensor_msgs::JointState& state) {
     last_state_wall_ = ros::WallTime::now();
     const auto finger = positions_.find("left_finger");
     if (finger != positions_.end()) {
-      const double t = ros::Time::now().toSec();
+      // The driver's stamp, not the arrival time: under load messages arrive in bursts.
+      const double t = state.header.stamp.isZero() ? ros::Time::now().toSec() : state.header.stamp.toSec();
       const auto v = velocities.find("left_finger");
+      if (!finger_history_.empty() && t < finger_history_.back().t) {
+        finger_history_.clear();  // time went back: the driver (simulator) restarted
+      }
       finger_history_.push_back({t, finger->second,
                                  v != velocities.end() ? v->second : std::numeric_limits<double>::quiet_NaN()});
       while (finger_history_.size() > 2 && finger_history_.front().t < t - 1.0) {

@@ -85,7 +85,7 @@ class ArmController {
   std::map<std::string, double> velocities_;
   ros::WallTime last_state_wall_;
   struct FingerSample {
-    double t;         // [s] ROS time of arrival
+    double t;         // [s] the message's stamp (arrival time if it has none)
     double position;  // [m] left_finger
     double velocity;  // [m/s] left_finger, NaN when the driver sends none
   };
