@@ -8,6 +8,7 @@ a cancelled move stops, and the gripper reports held on a sherd and not held on 
 import json
 import math
 import os
+import signal
 import subprocess
 import time
 
@@ -158,8 +159,12 @@ def test_joint_states_drive_fk_and_tf(ros_master, rosrun):
         static = ros_master.run(["rostopic", "echo", "-n", "1", "/tf_static"], timeout=30).stdout
         assert "camera_color_optical_frame" in static and "ee_gripper_link" in static
     finally:
-        os.killpg(pub.pid, 2)
-        pub.wait(timeout=10)
+        os.killpg(pub.pid, signal.SIGINT)
+        try:
+            pub.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(pub.pid, signal.SIGKILL)  # must not feed the next test's /joint_states
+            pub.wait()
 
 
 @requires_controller
