@@ -418,6 +418,18 @@ def _read_arm(arm: _Reader, stations: Dict[str, Station]) -> dict:
         arm.fail("standby", "inside the archival camera's view %s; the arm must park out of "
                  "view" % _fmt_rect(cam.area), list(standby))
     arm.number("speed_scale", 0.01, 1.0)
+    arm.number("acceleration_share", 0.1, 1.0)
+    arm.number("command_period", 0.001, 0.2, "seconds")
+    arm.number("goal_tolerance", 0.0001, 0.1, "radians")
+    arm.number("settle_timeout", 0.1, 30.0, "seconds")
+    arm.number("state_timeout", 0.1, 30.0, "seconds")
+    if not isinstance(arm.raw("publish_tf"), bool):
+        arm.fail("publish_tf", "expected true or false", arm.data["publish_tf"])
+    grip = arm.section("gripper")
+    grip.number("timeout", 0.1, 30.0, "seconds")
+    grip.number("stroke_time", 0.5, 10.0, "seconds (the servo needs at least 0.5)")
+    grip.number("held_margin", 0.0, 0.02, "metres")
+    grip.done()
     poses = arm.section("named_poses")
     for name in poses.data:
         poses.vector(name, 6, -math.pi, math.pi, "6 joint angles in radians (%s)" % ", ".join(
