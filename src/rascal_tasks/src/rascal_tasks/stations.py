@@ -46,9 +46,10 @@ class StationPlugin:
         """Called with the sherd in the gripper above the station (e.g. tare the scale)."""
 
     def after_place(self, sherd) -> str:
-        """Called with the sherd placed and the gripper back at travel height. Returns 'done',
-        or 'failed' when the station could not do its job: the batch then parks the arm with
-        the catalogue consistent, for a person to look (a restart resumes this sherd)."""
+        """Called with the sherd placed and the gripper back at travel height. Returns 'done';
+        'missing' when the sherd is evidently not there (it is searched for like a drop); or
+        'failed' when the station could not do its job: the batch then parks the arm with the
+        catalogue consistent, for a person to look (a restart resumes this sherd)."""
         raise NotImplementedError
 
 
@@ -72,9 +73,10 @@ class ScaleStation(StationPlugin):
                 self.batch.event(sherd, "scale_unstable", "attempt %d: %.1f g" % (
                     attempt + 1, reading.mass * 1000))
         if reading.mass < MIN_SHERD_MASS:
-            self.batch.event(sherd, "scale_failed", "reads %.1f g with the sherd on it; is it "
-                             "still in the gripper or off the platform?" % (reading.mass * 1000))
-            return "failed"
+            # Nothing on the pan: the sherd slipped away unnoticed on the way; look for it.
+            self.batch.event(sherd, "scale_empty", "reads %.1f g after placing the sherd" % (
+                reading.mass * 1000))
+            return "missing"
         sherd.mass = reading.mass
         # An unstable last reading is still recorded, and flagged in the sherd's notes.
         self.batch.recorder.mass(sherd.seq, reading.mass, reading.stable)

@@ -394,7 +394,7 @@ class AtStation(BatchState):
     """Runs the station plug-in (weigh, photograph, discard) and records what it measured."""
 
     def __init__(self, batch, index):
-        super().__init__(batch, ["done"])
+        super().__init__(batch, ["done", "dropped"])
         self.index = index
 
     def label(self):
@@ -402,7 +402,10 @@ class AtStation(BatchState):
 
     def run(self):
         b = self.batch
-        if b.plugins[self.index].after_place(b.sherd) != "done":
+        outcome = b.plugins[self.index].after_place(b.sherd)
+        if outcome == "missing":
+            return dropped(b, "not at the %s after placing" % b.station_names[self.index])
+        if outcome != "done":
             b.event(b.sherd, "station_failed", b.station_names[self.index])
             return "aborted"
         b.sherd.station_index = self.index
@@ -520,7 +523,7 @@ def build_machine(batch: Batch):
                 arrived="PLACE_%d" % i, dropped="RECOVER_%d" % i)
             add("PLACE_%d" % i, Place(batch, i), placed="STATION_%d" % i)
             add("STATION_%d" % i, AtStation(batch, i),
-                done="SURVEY_NEXT" if last else "REPICK_%d" % i)
+                done="SURVEY_NEXT" if last else "REPICK_%d" % i, dropped="RECOVER_%d" % i)
             if not last:
                 add("REPICK_%d" % i, Repick(batch, i),
                     held="TRANSLATE_%d" % (i + 1), lost="SURVEY_NEXT")
