@@ -139,3 +139,40 @@ TEST(ScenarioLoader, TouchingPairsMeet) {
   EXPECT_LT(minDistance(s.sherds[2], s.sherds[3]), 0.001);
   EXPECT_GT(minDistance(s.sherds[4], s.sherds[5]), 0.015);  // the third pair stays apart
 }
+
+TEST(SherdMeshBuilder, CollisionStripsCoverTheOutlineButNotTheBoxCorners) {
+  // a diamond: its bounding box corners are far outside it
+  const std::vector<Eigen::Vector2d> diamond = {{0.03, 0.0}, {0.0, 0.02}, {-0.03, 0.0}, {0.0, -0.02}};
+  const auto strips = SherdMeshBuilder::collisionStrips(diamond, 0.008, 6);
+  ASSERT_EQ(strips.size(), 6u);
+  auto covered = [&](const Eigen::Vector2d& p) {
+    for (const auto& b : strips) {
+      if (std::abs(p.x() - b.centre.x()) <= b.size.x() / 2 + 1e-9 &&
+          std::abs(p.y() - b.centre.y()) <= b.size.y() / 2 + 1e-9) return true;
+    }
+    return false;
+  };
+  for (const auto& v : diamond) EXPECT_TRUE(covered(v));
+  for (double t = 0.0; t <= 1.0; t += 0.05) EXPECT_TRUE(covered(diamond[0] * (1 - t) + diamond[1] * t));
+  EXPECT_FALSE(covered({0.028, 0.018}));
+  EXPECT_FALSE(covered({-0.028, -0.018}));
+  for (const auto& b : strips) EXPECT_DOUBLE_EQ(b.size.z(), 0.008);
+}
+
+TEST(SherdMeshBuilder, ScannedFragmentOutlineIsItsTopViewHull) {
+  SherdSpec s;
+  s.name = "fragment";
+  s.mesh_file = std::string(RASCAL_SIM_DATA_DIR) + "/archaide_braccio_frag_1.stl";
+  s.density = 1900;
+  const SherdGeometry g = SherdMeshBuilder::build(s);
+  ASSERT_GE(g.outline.size(), 5u);
+  double area = 0.0;
+  for (size_t i = 0; i < g.outline.size(); ++i) {
+    const auto& a = g.outline[i];
+    const auto& b = g.outline[(i + 1) % g.outline.size()];
+    area += (a.x() * b.y() - a.y() * b.x()) / 2;
+  }
+  EXPECT_GT(area, 0.0);  // counter-clockwise
+  EXPECT_LT(area, 0.95 * g.box_size.x() * g.box_size.y());  // not the bounding box
+  EXPECT_FALSE(g.collision.empty());
+}

@@ -144,15 +144,17 @@ TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {
   EXPECT_LT(sim.fingerPosition(), 0.0155);  // nothing left between the fingers
 }
 
-/// The scanned fragment (box 57.7 x 55.3 x 18.9 mm) on the scale pan, its box turned 45 degrees
-/// from the fingers: its corners wedge into the fully open fingers (box diagonal 80 mm > 74 mm),
-/// so the close stops at once and the sherd is held with the fingers at 0.037 m. The arm starts
-/// with ee_gripper_link 8 mm above the pan and lifts the sherd by 8 mm.
+/// A square slab (55 x 55 mm) on the scale pan turned 45 degrees from the fingers: its corners
+/// wedge into the fully open fingers (diagonal 78 mm > 74 mm), so the close stops at once and the
+/// sherd is held with the fingers at 0.037 m. The arm starts with ee_gripper_link 8 mm above the
+/// pan and lifts the sherd by 8 mm.
 static void wedgeOnTheScale(Simulator& sim, const WorldLayout& layout) {
   Scenario sc;
   SherdSpec s;
-  s.name = "fragment";
-  s.mesh_file = layout.data_dir + "/archaide_braccio_frag_1.stl";
+  s.name = "square";
+  s.outline = {{-0.0275, -0.0275}, {0.0275, -0.0275}, {0.0275, 0.0275}, {-0.0275, 0.0275}};
+  s.thickness = 0.008;
+  s.curvature = 4.0;
   s.density = 1900;
   const double x = layout.scale.position.x(), y = layout.scale.position.y();
   s.pose = {x, y, std::atan2(y, x) + M_PI / 4};
@@ -238,7 +240,13 @@ TEST(Simulator, OpeningPartlyReleasesAWedgedSherdOnTheScaleForGood) {
   EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, layout.scale_surface_z, 0.003);
   EXPECT_TRUE(r.stable);
   EXPECT_NEAR(r.mass, s.mass, 1e-4) << "truth " << s.mass;
-  // the next close grasps it again
+  // the next close, back down at grasp height, grasps it again
+  TrajectoryPoint down;
+  down.positions = pointingDownAt(layout.scale.position.x(), layout.scale.position.y(),
+                                  layout.scale_surface_z + 0.006);
+  down.time_from_start = 0.5;
+  sim.commandArm(sim.time(), {down}, {true, true, true, true, true, true});
+  for (int i = 0; i < 1000; ++i) sim.step();
   sim.commandGripper(0.015);
   for (int i = 0; i < 800; ++i) sim.step();
   EXPECT_TRUE(sim.groundTruth()[0].held);
@@ -323,6 +331,30 @@ static SimulatorOptions overTheFragment() {
   o.initial_joints = pointingDownAt(0.30, 0.20, 0.008);
   o.initial_finger = 0.03525;
   return o;
+}
+
+/// The scanned fragment is nearly square (57.7 x 55.3 mm box) but its corners are rounded: turned
+/// 45 degrees from the fingers it still fits the open gripper, as the real one would. A single
+/// bounding box as collision shape (80 mm diagonal) wedged it wide open instead.
+TEST(Simulator, AScannedFragmentAcrossItsDiagonalIsGraspedOnItsOutline) {
+  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
+  SimulatorOptions o = quiet();
+  o.initial_joints = pointingDownAt(0.30, 0.20, 0.008);
+  Simulator sim(layout, o);
+  Scenario sc;
+  SherdSpec s;
+  s.name = "fragment";
+  s.mesh_file = layout.data_dir + "/archaide_braccio_frag_1.stl";
+  s.density = 1900;
+  s.pose = {0.30, 0.20, std::atan2(0.20, 0.30) + M_PI / 4};
+  sc.sherds = {s};
+  sc.seed = 3;
+  sim.load(sc);
+  for (int i = 0; i < 200; ++i) sim.step();
+  sim.commandGripper(0.015);
+  for (int i = 0; i < 800; ++i) sim.step();
+  EXPECT_TRUE(sim.groundTruth()[0].held);
+  EXPECT_LT(sim.fingerPosition(), 0.036) << "wedged on the corners of a box the sherd does not fill";
 }
 
 TEST(Simulator, FingersGoOnClosingWhenAWedgedSherdIsDropped) {

@@ -1,5 +1,6 @@
 #include "rascal_sim/SherdMeshBuilder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -66,7 +67,63 @@ void subdivide(const Tri2& t, int levels, std::vector<Tri2>& out) {
   subdivide({ca, bc, t.c}, levels - 1, out);
   subdivide({ab, bc, ca}, levels - 1, out);
 }
+// 6 strips over a 40-60 mm sherd: each under 10 mm wide, so the staircase stays within ~3 mm of
+// a slanted edge while a resting sherd has a handful of contact boxes, not hundreds of triangles.
+constexpr int kCollisionStrips = 6;
 }  // namespace
+
+std::vector<Vec2> SherdMeshBuilder::convexHull(std::vector<Vec2> p) {
+  std::sort(p.begin(), p.end(), [](const Vec2& a, const Vec2& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (p.size() < 3) return p;
+  std::vector<Vec2> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {  // lower hull
+    while (k >= 2 && cross(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {  // upper hull
+    while (k >= t && cross(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+std::vector<CollisionBox> SherdMeshBuilder::collisionStrips(const std::vector<Vec2>& outline,
+                                                            double height, int strips) {
+  const std::vector<Vec2> hull = convexHull(outline);
+  std::vector<CollisionBox> boxes;
+  if (hull.size() < 3) return boxes;
+  double x0 = hull[0].x(), x1 = hull[0].x();
+  for (const auto& p : hull) {
+    x0 = std::min(x0, p.x());
+    x1 = std::max(x1, p.x());
+  }
+  const double dx = (x1 - x0) / strips;
+  for (int i = 0; i < strips; ++i) {
+    const double a = x0 + i * dx, b = a + dx;
+    // A convex polygon's y extent over [a, b] is reached at a vertex inside the strip or where
+    // an edge crosses x = a or x = b.
+    double lo = 1e9, hi = -1e9;
+    auto take = [&](double y) {
+      lo = std::min(lo, y);
+      hi = std::max(hi, y);
+    };
+    for (size_t j = 0; j < hull.size(); ++j) {
+      const Vec2& p = hull[j];
+      const Vec2& q = hull[(j + 1) % hull.size()];
+      if (p.x() >= a - 1e-12 && p.x() <= b + 1e-12) take(p.y());
+      for (double x : {a, b}) {
+        if ((p.x() - x) * (q.x() - x) < 0) take(p.y() + (q.y() - p.y()) * (x - p.x()) / (q.x() - p.x()));
+      }
+    }
+    if (hi <= lo) continue;
+    boxes.push_back({{(a + b) / 2, (lo + hi) / 2, 0.0}, {dx, hi - lo, height}});
+  }
+  return boxes;
+}
 
 SherdGeometry SherdMeshBuilder::build(const SherdSpec& spec) {
   SherdGeometry g;
@@ -83,8 +140,10 @@ SherdGeometry SherdMeshBuilder::build(const SherdSpec& spec) {
     g.volume = g.mesh.volume();
     g.length = std::max(g.box_size.x(), g.box_size.y());
     g.width = std::min(g.box_size.x(), g.box_size.y());
-    const double hx = g.box_size.x() / 2, hy = g.box_size.y() / 2;
-    g.outline = {{-hx, -hy}, {hx, -hy}, {hx, hy}, {-hx, hy}};
+    std::vector<Vec2> top_view;
+    top_view.reserve(g.mesh.vertices.size());
+    for (const auto& v : g.mesh.vertices) top_view.emplace_back(v.x(), v.y());
+    g.outline = convexHull(std::move(top_view));
   } else {
     if (spec.outline.size() < 3) throw std::runtime_error("sherd " + spec.name + ": outline needs >= 3 points");
     std::vector<Vec2> outline = spec.outline;
@@ -145,6 +204,7 @@ SherdGeometry SherdMeshBuilder::build(const SherdSpec& spec) {
     for (const auto& p : outline) g.outline.push_back(p - centre.head<2>());
   }
   g.mass = g.volume * spec.density;
+  g.collision = collisionStrips(g.outline, g.box_size.z(), kCollisionStrips);
   g.mesh.cull_back_faces = spec.mesh_file.empty();  // our shells are wound outwards
   g.mesh.updateBounds();
   return g;

@@ -51,7 +51,7 @@ struct World::Impl {
     SherdSpec spec;
     SherdGeometry geo;
     dBodyID body = nullptr;
-    dGeomID geom = nullptr;
+    std::vector<dGeomID> geoms;  // the collision strips, all on `body`
     GeomTag tag{GeomTag::kSherd, 0};
     double ignore_until = -1.0;
     bool ignore_overlap = false;  // arm contacts ignored until no arm box overlaps the sherd
@@ -320,7 +320,7 @@ void World::clearSherds() {
   Impl& w = *impl_;
   release();
   for (auto& s : w.sherds) {
-    dGeomDestroy(s->geom);
+    for (dGeomID g : s->geoms) dGeomDestroy(g);
     dBodyDestroy(s->body);
   }
   w.sherds.clear();
@@ -354,10 +354,14 @@ void World::spawn(const std::vector<SherdSpec>& sherds) {
     dBodySetRotation(s->body, r);
     dBodySetLinearDamping(s->body, 0.001);
     dBodySetAngularDamping(s->body, 0.01);
-    s->geom = dCreateBox(w.space, size.x(), size.y(), size.z());
-    dGeomSetBody(s->geom, s->body);
     s->tag.index = static_cast<int>(i);
-    dGeomSetData(s->geom, &s->tag);
+    for (const CollisionBox& c : s->geo.collision) {
+      dGeomID g = dCreateBox(w.space, c.size.x(), c.size.y(), c.size.z());
+      dGeomSetBody(g, s->body);
+      dGeomSetOffsetPosition(g, c.centre.x(), c.centre.y(), c.centre.z());
+      dGeomSetData(g, &s->tag);
+      s->geoms.push_back(g);
+    }
     w.sherds.push_back(std::move(s));
   }
 }
