@@ -50,6 +50,10 @@ class PhotoSegmenter {
 
  private:
   cv::Mat foreground(const cv::Mat& rgb, const cv::Mat& background) const;
+  /// Splits a blob in two along a straight dark crack from its deepest concavity when both
+  /// halves are far more convex than the whole: sherds lying edge to edge, which have no neck
+  /// for the distance transform and whose crack the closing has filled.
+  void splitAtSeams(std::vector<Blob>& blobs, const cv::Mat& rgb) const;
   /// Joins a much smaller blob to a larger one it (nearly) touches.
   void mergeFragments(std::vector<Blob>& blobs, const cv::Size& size) const;
   Options options_;

@@ -34,6 +34,9 @@ class SherdSegmenter {
                           SegmentationStats* stats = nullptr) const;
   /// Splits one filled blob mask at its necks; returns 1 mask if it is one sherd.
   std::vector<cv::Mat> split(const cv::Mat& mask, double min_neck, double min_peak_px) const;
+  /// The largest outer contour of `part` (CV_8U) as a blob; `offset` = image position of part(0, 0).
+  /// Empty contour if `part` is empty.
+  static Blob blobOf(const cv::Mat& part, const cv::Point& offset);
 
  private:
   mutable cv::Mat hsv_, background_;

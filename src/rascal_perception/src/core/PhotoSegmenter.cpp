@@ -82,6 +82,7 @@ cv::Mat PhotoSegmenter::foreground(const cv::Mat& rgb, const cv::Mat& background
     }
   }
   cv::morphologyEx(fg, fg, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+
   // dark glaze and painted lines must not cut a sherd in pieces
   const int close = std::max(3, (rgb.cols / 200) | 1);
   cv::morphologyEx(fg, fg, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(close, close)));
@@ -236,27 +237,108 @@ void PhotoSegmenter::mergeFragments(std::vector<Blob>& blobs, const cv::Size& si
         cv::Mat m = cv::Mat::zeros(canvas.size(), CV_8U);
         for (size_t k : {i, j}) blobs[k].mask.copyTo(m(cv::Rect(blobs[k].bounds.tl() - canvas.tl(), blobs[k].bounds.size())), blobs[k].mask);
         cv::morphologyEx(m, m, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * far + 1, 2 * far + 1)));
-        std::vector<std::vector<cv::Point>> contours;
-        cv::findContours(m, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, canvas.tl());
-        if (contours.empty()) continue;
-        size_t best = 0;
-        for (size_t k = 1; k < contours.size(); ++k) {
-          if (cv::contourArea(contours[k]) > cv::contourArea(contours[best])) best = k;
-        }
-        Blob b;
-        b.contour = std::move(contours[best]);
-        b.bounds = cv::boundingRect(b.contour);
-        b.mask = cv::Mat::zeros(b.bounds.size(), CV_8U);
-        cv::drawContours(b.mask, std::vector<std::vector<cv::Point>>{b.contour}, 0, cv::Scalar(255), cv::FILLED,
-                         cv::LINE_8, cv::noArray(), 0, -b.bounds.tl());
-        b.pixels = cv::countNonZero(b.mask);
-        b.box = cv::minAreaRect(b.contour);
+        Blob b = SherdSegmenter::blobOf(m, canvas.tl());
+        if (b.contour.empty()) continue;
         blobs[j] = std::move(b);
         blobs.erase(blobs.begin() + static_cast<long>(i));
         merged = true;
       }
     }
   }
+}
+
+namespace {
+// Seam splitting (photos only; the station detector has depth). Measured on the three real
+// photos: the two edge-to-edge pairs (img114, img071) score 42 and 45 grey levels of black-hat
+// along their crack and split into halves of solidity 0.95-0.96; no single sherd gives two
+// halves both above 0.92.
+constexpr double kSeamSolidityBelow = 0.9;   // only blobs this far from convex are looked at
+constexpr double kSeamMinDefect = 0.15;      // deepest concavity, x sqrt(area)
+constexpr double kSeamMinLength = 0.3;       // cut length, x sqrt(area)
+constexpr double kSeamMinContrast = 35.0;    // mean black-hat along the cut, grey levels
+constexpr double kSeamMinPart = 0.2;         // each half, x the blob's area
+constexpr double kSeamHalfSolidity = 0.93;   // each half must be this convex
+
+double solidity(const std::vector<cv::Point>& c) {
+  std::vector<cv::Point> hull;
+  cv::convexHull(c, hull);
+  const double h = cv::contourArea(hull);
+  return h > 0 ? cv::contourArea(c) / h : 1.0;
+}
+}  // namespace
+
+void PhotoSegmenter::splitAtSeams(std::vector<Blob>& blobs, const cv::Mat& rgb) const {
+  cv::Mat blackhat;  // thin dark lines, computed only if some blob needs it
+  std::vector<Blob> out;
+  for (Blob& b : blobs) {
+    const double area = cv::contourArea(b.contour);
+    std::vector<int> hull;
+    cv::convexHull(b.contour, hull, false, false);
+    std::vector<cv::Vec4i> defects;
+    if (hull.size() >= 3 && solidity(b.contour) < kSeamSolidityBelow) {
+      std::sort(hull.begin(), hull.end());  // convexityDefects wants a monotonic hull
+      try {
+        cv::convexityDefects(b.contour, hull, defects);
+      } catch (const cv::Exception&) {  // self-intersecting contour: leave the blob as it is
+        defects.clear();
+      }
+    }
+    const auto deepest = std::max_element(defects.begin(), defects.end(),
+                                          [](const cv::Vec4i& x, const cv::Vec4i& y) { return x[3] < y[3]; });
+    const double side = std::sqrt(area);
+    if (deepest == defects.end() || (*deepest)[3] / 256.0 < kSeamMinDefect * side) {
+      out.push_back(std::move(b));
+      continue;
+    }
+    if (blackhat.empty()) {
+      cv::Mat grey;
+      cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+      cv::morphologyEx(grey, blackhat, cv::MORPH_BLACKHAT, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
+    }
+    cv::Mat inside;
+    cv::erode(b.mask, inside, cv::Mat::ones(3, 3, CV_8U));
+    const cv::Point p = b.contour[(*deepest)[2]];
+    double best = -1.0;
+    cv::Point best_q;
+    for (size_t k = 0; k < b.contour.size(); k += 2) {
+      const cv::Point q = b.contour[k];
+      const double length = cv::norm(q - p);
+      if (length < kSeamMinLength * side) continue;
+      const int n = static_cast<int>(length);
+      double sum = 0.0;
+      int used = 0, outside = 0;
+      for (int i = 3; i <= n - 3; ++i) {  // the cut's ends lie on the edge
+        const double t = static_cast<double>(i) / n;
+        const cv::Point s(cvRound(p.x + t * (q.x - p.x)), cvRound(p.y + t * (q.y - p.y)));
+        if (!inside.at<uint8_t>(s - b.bounds.tl())) ++outside;
+        sum += blackhat.at<uint8_t>(s);
+        ++used;
+      }
+      if (used < 5 || outside > 0.05 * used) continue;  // the cut must run through the blob
+      if (sum / used > best) {
+        best = sum / used;
+        best_q = q;
+      }
+    }
+    std::vector<Blob> halves;
+    if (best >= kSeamMinContrast) {
+      cv::Mat cut = b.mask.clone();
+      cv::line(cut, p - b.bounds.tl(), best_q - b.bounds.tl(), cv::Scalar(0), 2);
+      cv::Mat labels, stats, centroids;
+      const int n = cv::connectedComponentsWithStats(cut, labels, stats, centroids, 4, CV_32S);
+      for (int i = 1; i < n; ++i) {
+        if (stats.at<int>(i, cv::CC_STAT_AREA) < kSeamMinPart * area) continue;
+        Blob half = SherdSegmenter::blobOf(labels == i, b.bounds.tl());
+        if (!half.contour.empty() && solidity(half.contour) >= kSeamHalfSolidity) halves.push_back(std::move(half));
+      }
+    }
+    if (halves.size() == 2) {
+      for (Blob& h : halves) out.push_back(std::move(h));
+    } else {
+      out.push_back(std::move(b));
+    }
+  }
+  blobs = std::move(out);
 }
 
 PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& background) const {
@@ -269,6 +351,7 @@ PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& backgroun
   o.split_min_neck = options_.split_min_neck;
   std::vector<Blob> blobs = SherdSegmenter().blobs(r.foreground, o);
   r.bar = findBar(rgb, blobs);
+  splitAtSeams(blobs, rgb);
   mergeFragments(blobs, rgb.size());
   const double mm_per_px = r.bar.found ? 10.0 / r.bar.px_per_cm : 0.0;
   for (Blob& b : blobs) {

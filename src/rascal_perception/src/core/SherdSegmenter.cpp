@@ -22,8 +22,7 @@ std::vector<Blob> SherdSegmenter::segment(const cv::Mat& rgb, const BackgroundMo
   return blobs(foreground, options, stats);
 }
 
-namespace {
-Blob makeBlob(const cv::Mat& part, const cv::Point& offset) {
+Blob SherdSegmenter::blobOf(const cv::Mat& part, const cv::Point& offset) {
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(part, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, offset);
   Blob b;
@@ -41,7 +40,6 @@ Blob makeBlob(const cv::Mat& part, const cv::Point& offset) {
   b.box = cv::minAreaRect(b.contour);
   return b;
 }
-}  // namespace
 
 std::vector<Blob> SherdSegmenter::blobs(const cv::Mat& mask, const SegmentationOptions& options,
                                         SegmentationStats* stats) const {
@@ -72,7 +70,7 @@ std::vector<Blob> SherdSegmenter::blobs(const cv::Mat& mask, const SegmentationO
     }
     if (parts.size() > 1) st.splits += static_cast<int>(parts.size()) - 1;
     for (const cv::Mat& p : parts) {
-      Blob b = makeBlob(p, padded.tl());
+      Blob b = blobOf(p, padded.tl());
       if (b.contour.empty()) continue;
       const double lo = std::min(b.box.size.width, b.box.size.height);
       const double hi = std::max(b.box.size.width, b.box.size.height);
