@@ -60,13 +60,15 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
     recorded = rows(db, "E2E-3")
     assert [r["seq"] for r in recorded] == [1, 2, 3], out[-2000:]
     assert all(r["status"] == "done" for r in recorded), recorded
-    # Each recorded mass matches one scenario sherd within 0.2 g (matched by pickup position).
+    # Each row is a different scenario sherd (matched by pickup position; two of them weigh
+    # about 21 g) and its mass matches that sherd's within 0.2 g.
+    names = set()
     for r in recorded:
         name = min(truth, key=lambda n: (truth[n][0] - r["pickup_x_m"]) ** 2
                    + (truth[n][1] - r["pickup_y_m"]) ** 2)
         assert abs(r["mass_g"] - truth[name][2] * 1000) < 0.2, (r["seq"], name, r["mass_g"])
-    masses = sorted(round(r["mass_g"]) for r in recorded)
-    assert len(set(masses)) == 3
+        names.add(name)
+    assert len(names) == 3, recorded
     # The archival image exists, is the one recorded, and shows something on the mat.
     import cv2
     import hashlib
@@ -98,6 +100,10 @@ def test_database_down_gives_clear_error_and_arm_does_not_move(rig_factory, tmp_
     assert max(abs(a - b) for a, b in zip(before, after, strict=True)) < 1e-3
 
 
+def _summary(recorded):
+    return [(r["seq"], r["status"], r["lost_reason"], r["notes"]) for r in recorded]
+
+
 def _matches_truth(recorded, truth):
     """Every recorded mass matches a different scenario sherd within 0.2 g."""
     left = dict(truth)
@@ -115,7 +121,7 @@ def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
     code, out = run_batch(rig, db, "E2E-DROP")
     assert code == 0, out[-3000:]
     recorded = rows(db, "E2E-DROP")
-    assert [r["status"] for r in recorded] == ["done"] * 3, recorded
+    assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     # The slip shows up as a drop of a numbered sherd or as one more grasp before numbering.
     assert sum(r["drops"] for r in recorded) + sum(r["grasp_attempts"] for r in recorded) > 3
     _matches_truth(recorded, truth)
@@ -139,7 +145,7 @@ def test_killed_mid_batch_resumes_without_duplicates(rig_factory, db, tmp_path):
     assert code == 0, out[-3000:]
     recorded = rows(db, "E2E-KILL")
     assert [r["seq"] for r in recorded] == [1, 2, 3]
-    assert [r["status"] for r in recorded] == ["done"] * 3, recorded
+    assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     _matches_truth(recorded, truth)
 
 
@@ -151,5 +157,5 @@ def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
     code, out = run_batch(rig, db, "E2E-TOUCH")
     assert code == 0, out[-3000:]
     recorded = rows(db, "E2E-TOUCH")
-    assert [r["status"] for r in recorded] == ["done"] * 3, recorded
+    assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     _matches_truth(recorded, truth)

@@ -23,6 +23,9 @@ class _Clock(rig.Clock):
     def now(self):
         return 0.0
 
+    def sleep(self, seconds):
+        pass
+
 
 def _batch(cfg):
     r = rig.Rig(rig.Arm(), rig.Gripper(), rig.Perception(), rig.Scale(), rig.ArchivalCamera(),
@@ -98,3 +101,123 @@ def test_lawnmower_covers_the_area_without_backtracking():
     assert len(grid) == 6
     assert [p[1] for p in grid[:2]] == pytest.approx([-0.05, 0.05])
     assert [p[1] for p in grid[2:4]] == pytest.approx([0.05, -0.05])  # boustrophedon
+
+
+# -- recovery of a dropped sherd, against an in-memory rig ---------------------------------------
+class _Arm(rig.Arm):
+    def __init__(self):
+        self.at = (0.0, 0.0)
+
+    def move_down(self, x, y, z, yaw, linear=False):
+        self.at = (x, y)
+        return 0.0
+
+
+class _Gripper(rig.Gripper):
+    def open(self, width=None):
+        return 0.0
+
+    def close(self):
+        return rig.GraspResult(True, 0.04)
+
+    def holding(self):
+        return True
+
+
+class _Perception(rig.Perception):
+    """Sees the sherds of `world` ({station: [Observation]}) within 0.15 m of the wrist."""
+
+    def __init__(self, arm, world):
+        self.arm, self.world, self.views = arm, world, []
+
+    def detect(self, station):
+        self.views.append(station)
+        cx, cy = self.arm.at
+        return [o for o in self.world.get(station, []) if o.distance_to(cx, cy) < 0.15]
+
+
+class _Recorder:
+    def __init__(self):
+        self.calls = []
+
+    def __getattr__(self, name):
+        return lambda *a, **k: self.calls.append((name,) + a)
+
+
+def _obs(x, y, length, width):
+    return rig.Observation(x, y, 0.0, length, width, 0.01, x, y, 0.005, 0.0, width + 0.01)
+
+
+def _dropped_on_the_way(data, world):
+    """A sherd picked at (0.12, 0.25), carried to the scale, not there after placing."""
+    cfg = config_from_dict(data)
+    arm = _Arm()
+    r = rig.Rig(arm, _Gripper(), _Perception(arm, world), rig.Scale(), rig.ArchivalCamera(),
+                _Clock())
+    batch = workflow.Batch(cfg, r, recorder=_Recorder(), context="T")
+    picked = _obs(0.12, 0.25, 0.055, 0.040)
+    scale = cfg.stations["scale"]
+    batch.sherd = workflow.SherdInProgress(4, picked, 0.0, 0.005, 0.040, where="scale",
+                                           last_xy=tuple(scale.place_at), picked_xy=(0.12, 0.25),
+                                           drops=1)
+    return batch
+
+
+def test_a_sherd_lost_on_the_way_is_found_in_the_pickup_area_by_its_likeness(data):
+    # It fell 9 cm from where it was picked; a smaller sherd lies closer to that spot.
+    lookalike, other = _obs(0.21, 0.25, 0.054, 0.041), _obs(0.16, 0.25, 0.030, 0.025)
+    batch = _dropped_on_the_way(data, {"pickup": [other, lookalike]})
+    assert workflow.Recover(batch).run() == "held"
+    assert batch.rig.arm.at == (lookalike.grasp_x, lookalike.grasp_y)
+    assert batch.sherd.where == "pickup" and batch.sherd.observation is lookalike
+    assert ("dimensions", 4, 0.054, 0.041, 0.01) in batch.recorder.calls
+    # looked at the scale first, then where it was picked, then over the pickup area
+    assert batch.rig.perception.views[:2] == ["scale", "pickup"]
+
+
+def test_a_sherd_found_nowhere_is_recorded_lost_and_the_batch_goes_on(data):
+    batch = _dropped_on_the_way(data, {})
+    assert workflow.Recover(batch).run() == "lost"
+    lost = [c for c in batch.recorder.calls if c[0] == "lost"]
+    assert lost and lost[0][1] == 4 and "pickup area" in lost[0][2]
+    assert batch.sherd is None and batch.lost == 1
+    assert len(batch.rig.perception.views) > 3  # the whole pickup area was surveyed
+
+
+class _Restarted(_Recorder):
+    """A context whose sherd 2 was weighed when the run was killed."""
+
+    def unfinished(self):
+        return [(2, "weighed", (0.15, 0.22))]
+
+
+def _restarted_batch(data, world):
+    cfg = config_from_dict(data)
+    arm = _Arm()
+    r = rig.Rig(arm, _Gripper(), _Perception(arm, world), rig.Scale(), rig.ArchivalCamera(),
+                _Clock())
+    return workflow.Batch(cfg, r, recorder=_Restarted(), context="T")
+
+
+def test_a_sherd_in_the_fingers_after_a_restart_is_set_down_and_carried_on(data):
+    batch = _restarted_batch(data, {"pickup": [_obs(0.151, 0.221, 0.05, 0.04)]})
+    moves = []
+    move = batch.rig.arm.move_down
+    batch.rig.arm.move_down = lambda x, y, z, yaw, linear=False: (moves.append((x, y, z)),
+                                                                  move(x, y, z, yaw))[1]
+    assert workflow.Home(batch).run() == "done"
+    # set down at its pickup spot, low over the mat, before anything else
+    assert moves[0][:2] == (0.15, 0.22) and moves[1] == (0.15, 0.22, workflow.PUT_BACK_HEIGHT
+                                                         + batch.pickup.surface_z)
+    assert batch.put_back == (2, 0.15, 0.22)
+    # weighed already: picked up again and carried to the next station (the camera)
+    assert workflow.Resume(batch).run() == "TRANSLATE_1"
+    assert batch.sherd.seq == 2 and batch.sherd.station_index == 0
+
+
+def test_an_empty_gripper_after_a_restart_is_only_opened(data):
+    batch = _restarted_batch(data, {})
+    batch.rig.gripper.close = lambda: rig.GraspResult(False, 0.03)
+    assert workflow.Home(batch).run() == "done"
+    assert batch.put_back is None
+    assert batch.rig.arm.at == tuple(batch.pickup.area.center)

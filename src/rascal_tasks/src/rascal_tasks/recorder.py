@@ -17,6 +17,7 @@ class Recorder:
         self.context = context
         self.log = log or (lambda msg: None)
         self._ids = {}  # seq -> sherd_id
+        self._unfinished = None  # read once, at start-up
         self.opened = catalogue.open_context(context, site)
 
     def _id(self, seq: int) -> int:
@@ -73,10 +74,15 @@ class Recorder:
     def note(self, seq, text: str):
         self.catalogue.add_note(self._id(seq), text)
 
-    def unfinished(self) -> List[Tuple[int, str]]:
-        rows = self.catalogue.resume(self.context)
-        self._ids.update({r["seq"]: r["sherd_id"] for r in rows})
-        return [(r["seq"], r["status"]) for r in rows]
+    def unfinished(self) -> List[Tuple[int, str, Tuple[float, float]]]:
+        """(seq, status, pickup (x, y) in m) of this rig's sherds that a killed run left
+        unfinished, oldest first, as they were at start-up."""
+        if self._unfinished is None:  # the catalogue logs a resume once per run
+            rows = self.catalogue.resume(self.context)
+            self._ids.update({r["seq"]: r["sherd_id"] for r in rows})
+            self._unfinished = [(r["seq"], r["status"], (r["pickup_x_m"], r["pickup_y_m"]))
+                                for r in rows]
+        return self._unfinished
 
     def rows(self):
         return self.catalogue.sherds(self.context)

@@ -31,6 +31,9 @@ CAMERA_OFFSET = 0.055
 MIN_OPENING, MAX_OPENING = 0.030, 0.074
 # Two detections closer than this are the same sherd seen from two survey poses.
 SAME_SHERD = 0.02
+# ee_gripper_link height above the pickup mat where Home lets go of a sherd found in the fingers
+# after a restart: fingertips 4.4 mm lower, so a sherd up to ~2 cm thick drops a few mm at most.
+PUT_BACK_HEIGHT = 0.025
 
 
 @dataclass
@@ -43,14 +46,10 @@ class SherdInProgress:
     station_index: int = -1  # last station done (-1: just picked)
     where: str = "pickup"  # station it was last seen at
     last_xy: tuple = (0.0, 0.0)
+    picked_xy: Optional[tuple] = None  # where in the pickup area it was picked (unknown on resume)
     drops: int = 0
     mass: Optional[float] = None
     timings: Timings = field(default_factory=Timings)
-
-    def record(self) -> dict:
-        o = self.observation
-        return {"seq": self.seq, "length_m": o.length, "width_m": o.width,
-                "thickness_m": o.height, "colour_rgb": list(o.colour), "mass_kg": self.mass}
 
 
 class BatchAborted(Exception):
@@ -76,6 +75,7 @@ class Batch:
         self.misses = {}  # rounded (x, y) -> pickups that failed there
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
         self.pending: List[Observation] = []
+        self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
         self.empty_surveys = 0
         self.completed = 0
         self.lost = 0
@@ -179,11 +179,32 @@ class BatchState(smach.State):
 
 
 class Home(BatchState):
+    """Open the gripper over the pickup area.
+
+    After a killed run the fingers may still hold its unfinished sherd (or be open around it):
+    a close tells. That sherd is set down where it was picked up, which is free, and Resume
+    picks it up again; the stations must be calibrated with nothing in the wrist camera's view."""
+
     def __init__(self, batch):
         super().__init__(batch, ["done"])
 
     def run(self):
         b = self.batch
+        rows = b.recorder.unfinished()
+        if rows:
+            with b.phase("grasping"):
+                in_hand = b.rig.gripper.close().holding
+            if in_hand:
+                seq, _status, (x, y) = rows[0]
+                b.move_down(x, y, b.travel_z(), 0.0)
+                # a short drop: after a restart the grasp height is not known
+                b.move_down(x, y, b.pickup.surface_z + PUT_BACK_HEIGHT, 0.0, linear=True)
+                with b.phase("grasping"):
+                    b.rig.gripper.open()
+                b.move_down(x, y, b.travel_z(), 0.0, linear=True)
+                b.put_back = (seq, x, y)
+                b.event(None, "put_back", "sherd %d was in the gripper; set down at its pickup "
+                        "spot (%.3f, %.3f) m" % (seq, x, y))
         with b.phase("grasping"):
             b.rig.gripper.open()
         b.move_down(*b.pickup.area.center, b.travel_z(), 0.0)
@@ -216,7 +237,8 @@ class Calibrate(BatchState):
 class Resume(BatchState):
     """After a restart: find the sherd a killed run left unfinished and carry on with it.
 
-    Outcomes name the state to go on with: TRANSLATE_k (it is still in the gripper),
+    Outcomes name the state to go on with: TRANSLATE_k (it was in the gripper; Home set it
+    down at its pickup spot and it is picked up again),
     STATION_i (it lies placed at station i, not yet measured there), REPICK_i (it lies at
     station i, measured), or SURVEY (nothing unfinished, or it is lost)."""
 
@@ -231,16 +253,12 @@ class Resume(BatchState):
         rows = b.recorder.unfinished()
         if not rows:
             return "SURVEY"
-        seq, status = rows[0]
+        seq, status, _pickup_xy = rows[0]
         statuses = [p.status for p in b.plugins]
         done = statuses.index(status) if status in statuses else -1
         b.event(None, "resume", "sherd %d was %s" % (seq, status))
-        if b.rig.gripper.holding():
-            width = b.rig.gripper.width()
-            o = Observation(0, 0, 0, width, width, 0.0, 0, 0, 0, 0, width)
-            b.sherd = SherdInProgress(seq, o, 0.0, 0.01, width, station_index=done,
-                                      timings=b.timings)
-            return "TRANSLATE_%d" % (done + 1)
+        if b.put_back and b.put_back[0] == seq:
+            return self.pick_put_back(seq, done)
         for i in range(max(done, 0), len(b.plugins)):
             st = b.plugins[i].station
             if b.plugins[i].release_from_above:
@@ -253,6 +271,21 @@ class Resume(BatchState):
                                           last_xy=(o.x, o.y), timings=b.timings)
                 return ("REPICK_%d" if i == done else "STATION_%d") % i
         b.recorder.lost(seq, "not found after restart (was %s)" % status)
+        b.lost += 1
+        return "SURVEY"
+
+    def pick_put_back(self, seq, done):
+        b = self.batch
+        _, x, y = b.put_back
+        near = [o for o in b.survey_at(b.pickup, x, y)
+                if o.distance_to(x, y) < b.config["recovery"]["search_radius"]]
+        for o in sorted(near, key=lambda o: o.distance_to(x, y))[:1]:
+            if grasp(b, o, b.pickup.surface_z):
+                b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - b.pickup.surface_z,
+                                          o.width, station_index=done, last_xy=(o.x, o.y),
+                                          picked_xy=(o.x, o.y), timings=b.timings)
+                return "TRANSLATE_%d" % (done + 1)
+        b.recorder.lost(seq, "set down at its pickup spot after restart, not picked up again")
         b.lost += 1
         return "SURVEY"
 
@@ -299,7 +332,8 @@ class Pickup(BatchState):
             if grasp(b, o, b.pickup.surface_z):
                 seq = b.recorder.new_sherd((o.x, o.y), attempts=attempt + 1)
                 b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - b.pickup.surface_z,
-                                          o.width, last_xy=(o.x, o.y), timings=b.timings)
+                                          o.width, last_xy=(o.x, o.y), picked_xy=(o.x, o.y),
+                                          timings=b.timings)
                 b.recorder.dimensions(seq, o.length, o.width, o.height)
                 return "held"
             seen = b.survey_at(b.pickup, o.x, o.y)
@@ -453,7 +487,9 @@ def lose(b: Batch, reason: str) -> str:
 
 
 class Recover(BatchState):
-    """A dropped sherd: look where it was last seen, then around the pickup area."""
+    """A dropped sherd: look where it was last seen, then where it was picked up, then over the
+    whole pickup area (a grasp that slips while lifting drops it back there). Of what is found,
+    the one most like it (position, then size) is taken, so another sherd lying near is not."""
 
     def __init__(self, batch):
         super().__init__(batch, ["held", "lost"])
@@ -461,22 +497,49 @@ class Recover(BatchState):
     def run(self):
         b = self.batch
         s = b.sherd
-        rec = b.config["recovery"]
-        if s.drops > rec["max_searches"]:
+        if s.drops > b.config["recovery"]["max_searches"]:
             return lose(b, "dropped %d times" % s.drops)
-        where = b.config.stations.get(s.where, b.pickup)
-        candidates = b.survey_at(where, *s.last_xy)
-        if not candidates and where is not b.pickup:
-            candidates = b.survey_at(b.pickup, *b.pickup.area.center)
-            where = b.pickup
+        station, candidates, ref = self.search(s)
         if not candidates:
-            return lose(b, "not found where it was last seen (%s)" % s.where)
-        o = min(candidates, key=lambda c: c.distance_to(*s.last_xy))
-        if grasp(b, o, where.surface_z):
-            s.grasp_yaw, s.width = o.grasp_yaw, o.width
-            s.grasp_height = o.grasp_z - where.surface_z
-            return "held"
-        return lose(b, "found but could not be picked up")
+            return lose(b, "not found where it was last seen (%s), nor in the pickup area"
+                        % s.where)
+        like = s.observation
+
+        def unlikeness(c):
+            # A drop scatters a sherd by centimetres; its size is measured within ~3 mm, so a
+            # size difference weighs four times a distance.
+            return c.distance_to(*ref) + 4 * (abs(c.length - like.length)
+                                              + abs(c.width - like.width))
+
+        o = min(candidates, key=unlikeness)
+        if not grasp(b, o, station.surface_z):
+            return lose(b, "found but could not be picked up")
+        s.grasp_yaw, s.width = o.grasp_yaw, o.width
+        s.grasp_height = o.grasp_z - station.surface_z
+        if station is b.pickup and s.station_index < 0:
+            # Picked afresh from the pickup area: what is in the gripper now is what gets measured.
+            s.observation, s.where, s.last_xy = o, b.pickup.name, (o.x, o.y)
+            b.recorder.dimensions(s.seq, o.length, o.width, o.height)
+        return "held"
+
+    def search(self, s: SherdInProgress):
+        """(station, detections, reference point) of the first place that shows something."""
+        b = self.batch
+        where = b.config.stations.get(s.where, b.pickup)
+        places = [(where, s.last_xy)]
+        if s.picked_xy is not None and (where is not b.pickup or s.picked_xy != s.last_xy):
+            places.append((b.pickup, s.picked_xy))
+        for station, xy in places:
+            seen = b.survey_at(station, *xy)
+            if seen:
+                return station, seen, xy
+        found: List[Observation] = []
+        for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size,
+                              b.config["survey"]["step"]):
+            _merge(found, b.survey_at(b.pickup, x, y))
+        found = [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD
+                                         for xy in b.unpickable)]
+        return b.pickup, found, s.picked_xy or s.last_xy
 
 
 class Park(BatchState):
