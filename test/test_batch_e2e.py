@@ -11,13 +11,6 @@ from rig_helpers import SCENARIOS, ground_truth, inject, joint_positions, migrat
 
 pytestmark = pytest.mark.timeout(900)
 
-# Whole batches in the simulator do not yet end the same way every run: a slip of the scanned
-# fragment (whose collision box wedges across the open fingers), or load-dependent timing, can
-# lose or abort a sherd. They run in every `make test` and report XPASS/XFAIL; they are not
-# allowed to block CI until they pass reliably (see the README's status notes).
-unsettled = pytest.mark.xfail(strict=False, reason="whole-batch outcome still varies between "
-                              "runs in simulation")
-
 SMALL = os.path.join(SCENARIOS, "small_3.yaml")
 
 
@@ -51,7 +44,6 @@ def rig_factory(ros_master):
         r.stop()
 
 
-@unsettled
 def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_path):
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
@@ -113,7 +105,6 @@ def _matches_truth(recorded, truth):
         del left[name]
 
 
-@unsettled
 def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
@@ -127,7 +118,6 @@ def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
     _matches_truth(recorded, truth)
 
 
-@unsettled
 def test_killed_mid_batch_resumes_without_duplicates(rig_factory, db, tmp_path):
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
@@ -149,7 +139,6 @@ def test_killed_mid_batch_resumes_without_duplicates(rig_factory, db, tmp_path):
     _matches_truth(recorded, truth)
 
 
-@unsettled
 def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
     rig = rig_factory(scenario=os.path.join(SCENARIOS, "touching_2.yaml"),
                       archive=tmp_path / "archive")
