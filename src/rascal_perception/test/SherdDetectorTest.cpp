@@ -144,7 +144,8 @@ TEST(SherdDetector, FindsTheDemoScenarioSherds) {
   for (const SherdDetection& s : r.sherds) {
     EXPECT_GE(s.grasp_width, 0.030);
     EXPECT_LE(s.grasp_width, 0.074);
-    EXPECT_GE(s.grasp.translation().z() - s.surface, 0.005 + 0.0044 - 1e-9);
+    const PerceptionConfig defaults;
+    EXPECT_GE(s.grasp.translation().z() - s.surface, defaults.grasp_tip_clearance + defaults.fingertip_offset - 1e-9);
   }
 }
 

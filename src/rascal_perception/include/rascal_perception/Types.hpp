@@ -37,7 +37,7 @@ struct PerceptionConfig {
   double depth_min = 0.15, depth_max = 1.0;  ///< [m] depth outside is ignored
   double grasp_margin = 0.012;         ///< [m] arm.grasp_margin: opening beyond the measured width
   double grasp_height_fraction = 0.6;  ///< fingertips close at this fraction of the measured height
-  double grasp_tip_clearance = 0.005;  ///< [m] fingertips never lower than this above the surface
+  double grasp_tip_clearance = 0.0025; ///< [m] fingertips never lower than this above the surface (facts: the paper's clearance)
   double fingertip_offset = 0.0044;    ///< [m] fingertips below ee_gripper_link (finger box end)
   double split_min_neck = 0.75;        ///< touching sherds split where the neck < this x the smaller peak
   double plane_tolerance = 0.003;      ///< [m] RANSAC inlier distance of the table plane
