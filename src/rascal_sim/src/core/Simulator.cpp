@@ -148,7 +148,9 @@ void Simulator::updateGrasp() {
   const Eigen::Vector3d a = s.pose.linear().transpose() * arm[kFingersLink].linear().col(1);
   const double along = std::abs(a.x()) / std::max(1e-9, std::hypot(a.x(), a.y()));
   const double elongation = 1.0 - s.width / std::max(1e-9, s.length);
-  double p = 0.02 + 0.5 * off * off + 0.6 * along * along * std::min(1.0, 0.3 + 2.0 * elongation);
+  // A sherd as wide as it is long has no long axis to close along (turned 90° it is the same
+  // grasp), so that term grows with the elongation, in full from W/L = 0.6.
+  double p = 0.02 + 0.5 * off * off + 0.6 * along * along * std::min(1.0, 2.5 * elongation);
   if (s.mass > kMaxPayload) p += 0.9;
   p = std::min(0.98, p);
   const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng_);
