@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "rascal_sim/MunsellTable.hpp"
@@ -175,4 +176,19 @@ TEST(SherdMeshBuilder, ScannedFragmentOutlineIsItsTopViewHull) {
   EXPECT_GT(area, 0.0);  // counter-clockwise
   EXPECT_LT(area, 0.95 * g.box_size.x() * g.box_size.y());  // not the bounding box
   EXPECT_FALSE(g.collision.empty());
+}
+
+TEST(SherdMeshBuilder, PrincipalAxesOfATurnedRectangle) {
+  const Eigen::Rotation2Dd r(0.5);
+  std::vector<Eigen::Vector2d> rect;
+  for (const Eigen::Vector2d& q : {Eigen::Vector2d(-0.03, -0.015), Eigen::Vector2d(0.03, -0.015),
+                                   Eigen::Vector2d(0.03, 0.015), Eigen::Vector2d(-0.03, 0.015)}) {
+    rect.push_back(r * q + Eigen::Vector2d(0.01, -0.02));
+  }
+  const OutlineAxes ax = SherdMeshBuilder::principalAxes(rect);
+  EXPECT_NEAR(std::abs(ax.major.dot(Eigen::Vector2d(std::cos(0.5), std::sin(0.5)))), 1.0, 1e-9);
+  EXPECT_NEAR(ax.length, 0.06, 1e-9);
+  EXPECT_NEAR(ax.width, 0.03, 1e-9);
+  std::reverse(rect.begin(), rect.end());  // clockwise: the same axes
+  EXPECT_NEAR(SherdMeshBuilder::principalAxes(rect).length, 0.06, 1e-9);
 }

@@ -27,6 +27,12 @@ struct SherdGeometry {
   std::vector<Eigen::Vector2d> outline;  ///< in the body frame; for a scanned mesh its top-view hull
 };
 
+/// A top-view outline's principal axes (area second moments), in its own frame.
+struct OutlineAxes {
+  Eigen::Vector2d major{1.0, 0.0};  ///< unit direction of the major axis
+  double length = 0.0, width = 0.0; ///< [m] extents along and across it
+};
+
 class SherdMeshBuilder {
  public:
   /// Throws std::runtime_error if the outline has fewer than 3 points or the STL is unreadable.
@@ -34,6 +40,9 @@ class SherdMeshBuilder {
   /// `strips` boxes along x covering the convex hull of `outline`, `height` tall, centred on z = 0.
   static std::vector<CollisionBox> collisionStrips(const std::vector<Eigen::Vector2d>& outline,
                                                    double height, int strips);
+  /// The generator's length x width box is not this: it scales a random polygon into the box,
+  /// so its axes can be 30° off the outline's own (the ones a person or the detector sees).
+  static OutlineAxes principalAxes(const std::vector<Eigen::Vector2d>& outline);
   /// Convex hull, counter-clockwise (Andrew's monotone chain).
   static std::vector<Eigen::Vector2d> convexHull(std::vector<Eigen::Vector2d> points);
 };

@@ -72,6 +72,42 @@ void subdivide(const Tri2& t, int levels, std::vector<Tri2>& out) {
 constexpr int kCollisionStrips = 6;
 }  // namespace
 
+OutlineAxes SherdMeshBuilder::principalAxes(const std::vector<Vec2>& p) {
+  OutlineAxes ax;
+  if (p.size() < 3) return ax;
+  double a = 0.0, cx = 0.0, cy = 0.0, sxx = 0.0, syy = 0.0, sxy = 0.0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Vec2& u = p[i];
+    const Vec2& v = p[(i + 1) % p.size()];
+    const double c = cross(u, v);
+    a += c;
+    cx += (u.x() + v.x()) * c;
+    cy += (u.y() + v.y()) * c;
+    sxx += (u.x() * u.x() + u.x() * v.x() + v.x() * v.x()) * c;
+    syy += (u.y() * u.y() + u.y() * v.y() + v.y() * v.y()) * c;
+    sxy += (u.x() * v.y() + 2 * u.x() * u.y() + 2 * v.x() * v.y() + v.x() * u.y()) * c;
+  }
+  if (std::abs(a) < 1e-12) return ax;
+  a /= 2;
+  cx /= 6 * a;
+  cy /= 6 * a;
+  const double vxx = sxx / (12 * a) - cx * cx, vyy = syy / (12 * a) - cy * cy;
+  const double vxy = sxy / (24 * a) - cx * cy;
+  const double angle = 0.5 * std::atan2(2 * vxy, vxx - vyy);
+  ax.major = {std::cos(angle), std::sin(angle)};
+  const Vec2 minor(-ax.major.y(), ax.major.x());
+  double lo = 1e9, hi = -1e9, lo2 = 1e9, hi2 = -1e9;
+  for (const auto& q : p) {
+    lo = std::min(lo, q.dot(ax.major));
+    hi = std::max(hi, q.dot(ax.major));
+    lo2 = std::min(lo2, q.dot(minor));
+    hi2 = std::max(hi2, q.dot(minor));
+  }
+  ax.length = hi - lo;
+  ax.width = hi2 - lo2;
+  return ax;
+}
+
 std::vector<Vec2> SherdMeshBuilder::convexHull(std::vector<Vec2> p) {
   std::sort(p.begin(), p.end(), [](const Vec2& a, const Vec2& b) {
     return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());

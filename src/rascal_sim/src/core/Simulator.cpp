@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rascal_sim/SherdMeshBuilder.hpp"
+
 namespace rascal_sim {
 
 namespace {
 constexpr double kExposure = 0.01;  // [s] wrist colour exposure used for the blur length
-}
+}  // namespace
 
 Simulator::Simulator(const WorldLayout& layout, const SimulatorOptions& options)
     : layout_(layout),
@@ -145,9 +147,11 @@ void Simulator::updateGrasp() {
   const auto& arm = world_.armPose();
   const Eigen::Vector3d c = s.pose.inverse() * arm[kEeGripperLink].translation();
   const double off = std::min(1.0, std::hypot(c.x(), c.y()) / std::max(1e-3, 0.5 * s.length));
+  // along the outline's own major axis, as a person (and the detector) sees it
+  const OutlineAxes axes = SherdMeshBuilder::principalAxes(s.outline);
   const Eigen::Vector3d a = s.pose.linear().transpose() * arm[kFingersLink].linear().col(1);
-  const double along = std::abs(a.x()) / std::max(1e-9, std::hypot(a.x(), a.y()));
-  const double elongation = 1.0 - s.width / std::max(1e-9, s.length);
+  const double along = std::abs(a.head<2>().dot(axes.major)) / std::max(1e-9, a.head<2>().norm());
+  const double elongation = axes.length > 0 ? 1.0 - axes.width / axes.length : 0.0;
   // A sherd as wide as it is long has no long axis to close along (turned 90° it is the same
   // grasp), so that term grows with the elongation, in full from W/L = 0.6.
   double p = 0.02 + 0.5 * off * off + 0.6 * along * along * std::min(1.0, 2.5 * elongation);
