@@ -221,3 +221,14 @@ def test_an_empty_gripper_after_a_restart_is_only_opened(data):
     assert workflow.Home(batch).run() == "done"
     assert batch.put_back is None
     assert batch.rig.arm.at == tuple(batch.pickup.area.center)
+
+
+def test_the_selection_policies_order_the_merged_survey():
+    a = _obs(0.10, 0.20, 0.040, 0.030)  # nearest the base
+    b = _obs(0.30, 0.30, 0.060, 0.045)  # largest, far from the others
+    c = _obs(0.16, 0.20, 0.045, 0.035)  # close beside a
+    found = [c, b, a]
+    assert workflow.in_pick_order(found, "nearest") == [a, c, b]
+    assert workflow.in_pick_order(found, "largest") == [b, c, a]
+    assert workflow.in_pick_order(found, "most_isolated")[0] is b
+    assert workflow.in_pick_order([a], "most_isolated") == [a]

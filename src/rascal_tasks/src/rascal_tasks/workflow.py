@@ -134,6 +134,20 @@ class Batch:
         return (self.rig.clock.now() - self.started) / done if done else 0.0
 
 
+def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
+    """The perception's selection policy over the merged survey (the detector orders each
+    frame; a survey merges several). Python's sort is stable: detection order breaks ties."""
+    if policy == "largest":
+        return sorted(found, key=lambda o: -o.length * o.width)
+    if policy == "most_isolated":
+        def gap(o):  # to the nearest neighbour, edge to edge along the line of centres
+            return min((o.distance_to(p.x, p.y) - (o.length + p.length) / 2
+                        for p in found if p is not o), default=math.inf)
+        return sorted(found, key=lambda o: -gap(o))
+    # nearest to the arm's base first: the shortest reach, the least time
+    return sorted(found, key=lambda o: math.hypot(o.x, o.y))
+
+
 def opening_for(width: float, margin: float) -> float:
     return min(MAX_OPENING, max(MIN_OPENING, width + margin))
 
@@ -309,12 +323,7 @@ class Survey(BatchState):
                 return "empty"
             return self.run()
         b.empty_surveys = 0
-        policy = b.config["perception"]["selection_policy"]
-        if policy == "largest":
-            found.sort(key=lambda o: -o.length * o.width)
-        else:  # nearest first: shortest reach, least time; perception's order breaks ties
-            found.sort(key=lambda o: math.hypot(o.x, o.y))
-        b.pending = found
+        b.pending = in_pick_order(found, b.config["perception"]["selection_policy"])
         return "found"
 
 
