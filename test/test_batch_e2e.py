@@ -148,3 +148,29 @@ def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
     recorded = rows(db, "E2E-TOUCH")
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     _matches_truth(recorded, truth)
+
+
+def test_ctrl_c_parks_the_arm_and_a_rerun_finishes_the_batch(rig_factory, db, tmp_path):
+    rig = rig_factory(archive=tmp_path / "archive")
+    truth = ground_truth(rig)
+    proc = rig.rascal("--dsn", db, "run", "--context", "E2E-INT")
+    deadline = time.monotonic() + 600
+    while time.monotonic() < deadline and proc.poll() is None:
+        if any(r["status"] == "weighed" for r in rows(db, "E2E-INT")):
+            break
+        time.sleep(0.2)
+    assert proc.poll() is None, "batch ended before Ctrl-C"
+    proc.send_signal(signal.SIGINT)  # what Ctrl-C in the terminal sends
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode == 130, out[-3000:]
+    sleep = [0.0, -1.80, 1.55, 0.0, 0.8, 0.0]  # arm.named_poses.sleep of config/rascal.yaml
+    assert max(abs(a - b) for a, b in zip(joint_positions(rig), sleep, strict=True)) < 0.05
+    # nothing recorded is lost: the sherd in progress is neither done nor lost, only unfinished
+    statuses = [r["status"] for r in rows(db, "E2E-INT")]
+    assert "lost" not in statuses and statuses[-1] in ("weighed", "photographed"), statuses
+    code, out = run_batch(rig, db, "E2E-INT")
+    assert code == 0, out[-3000:]
+    recorded = rows(db, "E2E-INT")
+    assert [r["seq"] for r in recorded] == [1, 2, 3]
+    assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
+    _matches_truth(recorded, truth)
