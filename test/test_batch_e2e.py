@@ -118,25 +118,38 @@ def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
     _matches_truth(recorded, truth)
 
 
-def test_killed_mid_batch_resumes_without_duplicates(rig_factory, db, tmp_path):
-    rig = rig_factory(archive=tmp_path / "archive")
-    truth = ground_truth(rig)
-    proc = rig.rascal("--dsn", db, "run", "--context", "E2E-KILL")
+def _interrupt_when_weighed(rig, db, context, sig):
+    """Start a batch, and send `sig` to it once a sherd lies weighed (mid-batch)."""
+    proc = rig.rascal("--dsn", db, "run", "--context", context)
     deadline = time.monotonic() + 600
     while time.monotonic() < deadline and proc.poll() is None:
-        if any(r["status"] == "weighed" for r in rows(db, "E2E-KILL")):
+        if any(r["status"] == "weighed" for r in rows(db, context)):
             break
         time.sleep(0.2)
-    assert proc.poll() is None, "batch ended before it could be killed"
-    os.killpg(proc.pid, signal.SIGKILL)  # no clean-up of any kind
-    proc.wait()
-    assert [r["status"] for r in rows(db, "E2E-KILL")][-1] in ("weighed", "photographed")
-    code, out = run_batch(rig, db, "E2E-KILL")
+    assert proc.poll() is None, "batch ended before it could be interrupted"
+    if sig == signal.SIGKILL:
+        os.killpg(proc.pid, signal.SIGKILL)  # no clean-up of any kind
+    else:
+        proc.send_signal(sig)
+    out, _ = proc.communicate(timeout=120)
+    return proc.returncode, out
+
+
+def _rerun_finishes_once_each(rig, db, context, truth):
+    code, out = run_batch(rig, db, context)
     assert code == 0, out[-3000:]
-    recorded = rows(db, "E2E-KILL")
+    recorded = rows(db, context)
     assert [r["seq"] for r in recorded] == [1, 2, 3]
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     _matches_truth(recorded, truth)
+
+
+def test_killed_mid_batch_resumes_without_duplicates(rig_factory, db, tmp_path):
+    rig = rig_factory(archive=tmp_path / "archive")
+    truth = ground_truth(rig)
+    _interrupt_when_weighed(rig, db, "E2E-KILL", signal.SIGKILL)
+    assert [r["status"] for r in rows(db, "E2E-KILL")][-1] in ("weighed", "photographed")
+    _rerun_finishes_once_each(rig, db, "E2E-KILL", truth)
 
 
 def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
@@ -153,24 +166,11 @@ def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
 def test_ctrl_c_parks_the_arm_and_a_rerun_finishes_the_batch(rig_factory, db, tmp_path):
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
-    proc = rig.rascal("--dsn", db, "run", "--context", "E2E-INT")
-    deadline = time.monotonic() + 600
-    while time.monotonic() < deadline and proc.poll() is None:
-        if any(r["status"] == "weighed" for r in rows(db, "E2E-INT")):
-            break
-        time.sleep(0.2)
-    assert proc.poll() is None, "batch ended before Ctrl-C"
-    proc.send_signal(signal.SIGINT)  # what Ctrl-C in the terminal sends
-    out, _ = proc.communicate(timeout=120)
-    assert proc.returncode == 130, out[-3000:]
+    code, out = _interrupt_when_weighed(rig, db, "E2E-INT", signal.SIGINT)  # what Ctrl-C sends
+    assert code == 130, out[-3000:]
     sleep = [0.0, -1.80, 1.55, 0.0, 0.8, 0.0]  # arm.named_poses.sleep of config/rascal.yaml
     assert max(abs(a - b) for a, b in zip(joint_positions(rig), sleep, strict=True)) < 0.05
     # nothing recorded is lost: the sherd in progress is neither done nor lost, only unfinished
     statuses = [r["status"] for r in rows(db, "E2E-INT")]
     assert "lost" not in statuses and statuses[-1] in ("weighed", "photographed"), statuses
-    code, out = run_batch(rig, db, "E2E-INT")
-    assert code == 0, out[-3000:]
-    recorded = rows(db, "E2E-INT")
-    assert [r["seq"] for r in recorded] == [1, 2, 3]
-    assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
-    _matches_truth(recorded, truth)
+    _rerun_finishes_once_each(rig, db, "E2E-INT", truth)

@@ -92,17 +92,22 @@ static JointVector pointingDownAt(double x, double y, double z) {
 /// Gripper pointing down over (0.30, 0.20) with the fingertips 6 mm above the table.
 static JointVector overSherd() { return pointingDownAt(0.30, 0.20, 0.006); }
 
-/// Grasps a centred sherd (across its minor axis) and lifts it by 0.3 rad of shoulder.
-static void graspAndLift(Simulator& sim, const JointVector& start) {
+/// Loads `s` alone, lets it settle, closes the fingers and waits for them to stop.
+static void closeOn(Simulator& sim, const SherdSpec& s) {
   Scenario sc;
-  SherdSpec s = slab("c", 0.30, 0.20, 1850);
-  s.pose.z() = std::atan2(0.20, 0.30);  // fingers close across the sherd's minor axis
   sc.sherds = {s};
   sc.seed = 3;
   sim.load(sc);
   for (int i = 0; i < 200; ++i) sim.step();
   sim.commandGripper(0.015);
   for (int i = 0; i < 800; ++i) sim.step();
+}
+
+/// Grasps a centred sherd (across its minor axis) and lifts it by 0.3 rad of shoulder.
+static void graspAndLift(Simulator& sim, const JointVector& start) {
+  SherdSpec s = slab("c", 0.30, 0.20, 1850);
+  s.pose.z() = std::atan2(0.20, 0.30);  // fingers close across the sherd's minor axis
+  closeOn(sim, s);
   EXPECT_TRUE(sim.groundTruth()[0].held);
   EXPECT_NEAR(sim.fingerPosition(), 0.0175, 0.002);  // stopped on the 35 mm wide sherd
   TrajectoryPoint p;
@@ -341,18 +346,12 @@ TEST(Simulator, AScannedFragmentAcrossItsDiagonalIsGraspedOnItsOutline) {
   SimulatorOptions o = quiet();
   o.initial_joints = pointingDownAt(0.30, 0.20, 0.008);
   Simulator sim(layout, o);
-  Scenario sc;
   SherdSpec s;
   s.name = "fragment";
   s.mesh_file = layout.data_dir + "/archaide_braccio_frag_1.stl";
   s.density = 1900;
   s.pose = {0.30, 0.20, std::atan2(0.20, 0.30) + M_PI / 4};
-  sc.sherds = {s};
-  sc.seed = 3;
-  sim.load(sc);
-  for (int i = 0; i < 200; ++i) sim.step();
-  sim.commandGripper(0.015);
-  for (int i = 0; i < 800; ++i) sim.step();
+  closeOn(sim, s);
   EXPECT_TRUE(sim.groundTruth()[0].held);
   EXPECT_LT(sim.fingerPosition(), 0.036) << "wedged on the corners of a box the sherd does not fill";
 }

@@ -232,3 +232,23 @@ def test_the_selection_policies_order_the_merged_survey():
     assert workflow.in_pick_order(found, "largest") == [b, c, a]
     assert workflow.in_pick_order(found, "most_isolated")[0] is b
     assert workflow.in_pick_order([a], "most_isolated") == [a]
+
+
+def test_calibration_keeps_the_model_of_a_station_where_a_sherd_lies(data):
+    """After a restart the unfinished sherd may lie on the scale: learning it as background
+    would hide it from the resume."""
+    cfg = config_from_dict(data)
+    calibrated = []
+
+    class Perception(rig.Perception):
+        def detect_if_calibrated(self, station):
+            return [_obs(0.30, 0.0, 0.05, 0.04)] if station == "scale" else None
+
+        def calibrate(self, station):
+            calibrated.append(station)
+
+    r = rig.Rig(_Arm(), _Gripper(), Perception(), rig.Scale(), rig.ArchivalCamera(), _Clock())
+    batch = workflow.Batch(cfg, r, recorder=_Recorder(), context="T")
+    assert workflow.Calibrate(batch).run() == "done"
+    assert "scale" not in calibrated
+    assert {"camera", "discard", "pickup"} <= set(calibrated)

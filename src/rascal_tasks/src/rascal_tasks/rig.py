@@ -122,6 +122,10 @@ class Perception:
     def detect(self, station: str) -> List[Observation]:
         raise NotImplementedError
 
+    def detect_if_calibrated(self, station: str) -> Optional[List[Observation]]:
+        """Like detect, but None at once if the station has no background model yet."""
+        raise NotImplementedError
+
 
 class Scale:
     def tare(self) -> None:

@@ -172,6 +172,17 @@ class RosPerception(rig.Perception):
         res = self._call(self._detect, station, "DETECT")
         return [observation_from_msg(s) for s in res.detections.sherds]
 
+    def detect_if_calibrated(self, station):
+        try:
+            res = self._detect(station)
+        except rospy.ServiceException as e:
+            raise rig.RigError("perception", "DETECT", str(e)) from None
+        if res.success:
+            return [observation_from_msg(s) for s in res.detections.sherds]
+        if "no background model" in res.message:
+            return None
+        return self.detect(station)  # any other failure: the usual retries
+
 
 class RosScale(rig.Scale):
     """/scale/mass readings; a stable reading counts only if taken after the request."""

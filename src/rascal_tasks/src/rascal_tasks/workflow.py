@@ -126,6 +126,16 @@ class Batch:
             self.rig.clock.sleep(self.config["survey"]["settle_time"])
             return self.rig.perception.detect(station.name)
 
+    def survey_pickup_area(self) -> List[Observation]:
+        """The lawnmower over the pickup area, views merged. Sherds the gripper failed on
+        again and again are left out: they stay where they are, for a person."""
+        found: List[Observation] = []
+        for x, y in lawnmower(self.pickup.area.center, self.pickup.area.size,
+                              self.config["survey"]["step"]):
+            _merge(found, self.survey_at(self.pickup, x, y))
+        return [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD
+                                        for xy in self.unpickable)]
+
     def travel_z(self) -> float:
         return self.config["arm"]["travel_z"]
 
@@ -227,20 +237,28 @@ class Home(BatchState):
 
 class Calibrate(BatchState):
     """Learn each station's background from an image of it. The pickup area is full of sherds,
-    so its background (the same mat) is learnt where the discard box's mat shows."""
+    so its background (the same mat) is learnt where the discard box's mat shows.
+
+    A station where the scale or the camera already sees a sherd keeps the model it had: that
+    is a killed run's sherd (or one left by hand), and learning it as background would hide it."""
 
     def __init__(self, batch):
         super().__init__(batch, ["done"])
 
     def run(self):
         b = self.batch
-        for st in b.config.stations.values():
-            if st.type == "pickup":
-                continue
+        for plugin in b.plugins:
+            st = plugin.station
             yaw = math.atan2(st.place_at[1], st.place_at[0])
             x, y = st.place_at
             b.move_down(x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw),
                         st.surface_z + b.config["survey"]["z"], yaw)
+            if not plugin.release_from_above:
+                seen = b.rig.perception.detect_if_calibrated(st.name)
+                if seen:
+                    b.event(None, "calibration_kept", "%d sherd(s) lying at the %s: its "
+                            "background model from before is kept" % (len(seen), st.name))
+                    continue
             b.rig.perception.calibrate(st.name)
             if st.type == "discard":
                 b.rig.perception.calibrate(b.pickup.name)
@@ -310,13 +328,7 @@ class Survey(BatchState):
 
     def run(self):
         b = self.batch
-        found: List[Observation] = []
-        for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size,
-                              b.config["survey"]["step"]):
-            _merge(found, b.survey_at(b.pickup, x, y))
-        # Sherds the gripper failed on again and again stay where they are, for a person.
-        found = [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD
-                                         for xy in b.unpickable)]
+        found = b.survey_pickup_area()
         if not found:
             b.empty_surveys += 1
             if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
@@ -542,13 +554,7 @@ class Recover(BatchState):
             seen = b.survey_at(station, *xy)
             if seen:
                 return station, seen, xy
-        found: List[Observation] = []
-        for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size,
-                              b.config["survey"]["step"]):
-            _merge(found, b.survey_at(b.pickup, x, y))
-        found = [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD
-                                         for xy in b.unpickable)]
-        return b.pickup, found, s.picked_xy or s.last_xy
+        return b.pickup, b.survey_pickup_area(), s.picked_xy or s.last_xy
 
 
 class Park(BatchState):
