@@ -17,7 +17,7 @@ from rascal_tasks.config import ConfigError
 from rascal_tasks.recorder import Recorder
 from rascal_tasks.rig import Rig, RigError
 from rascal_tasks.ros_config import load_from_param_server
-from rascal_tasks.workflow import Batch, build_machine
+from rascal_tasks.workflow import Batch, build_machine, smach
 
 
 class ProgressLine:
@@ -81,6 +81,9 @@ def run(context: str, dsn: str = None) -> int:
     progress = ProgressLine()
     batch = Batch(cfg, rig, recorder, context, progress=progress, log=rospy.loginfo)
     progress.batch = batch
+    # The machine's own chatter (states added, every transition) goes to the node's log; the
+    # terminal shows the progress line and what happened to sherds.
+    smach.set_loggers(rospy.logdebug, rospy.logwarn, rospy.logdebug, rospy.logerr)
     machine = build_machine(batch)
     stop = threading.Event()
 

@@ -620,5 +620,8 @@ class _Next(BatchState):
     def __init__(self, batch):
         super().__init__(batch, ["pickup", "survey"])
 
+    def label(self):
+        return "Next sherd"
+
     def run(self):
         return "pickup" if self.batch.pending else "survey"
