@@ -16,11 +16,13 @@
 using namespace rascal_perception;
 
 namespace {
-int usage() {
-  std::fprintf(stderr,
+int usage(FILE* to = stderr, int code = 2) {
+  std::fprintf(to,
                "usage: segment_image <photo> [--background auto|<empty.jpg>] [--json out.json] [--png out.png]\n"
-               "                     [--mask foreground.png] [--bar-length cm] [--clusters k]\n");
-  return 2;
+               "                     [--mask foreground.png] [--bar-length cm] [--clusters k]\n"
+               "Finds the sherds and the black/white scale bar in a photo; prints JSON (sizes in mm when\n"
+               "the bar is found). --background auto learns the background from the photo itself.\n");
+  return code;
 }
 
 cv::Mat readRgb(const std::string& path) {
@@ -93,6 +95,7 @@ cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
 
 int main(int argc, char** argv) {
   if (argc < 2) return usage();
+  if (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") return usage(stdout, 0);
   std::string image = argv[1], background = "auto", json_path, png_path, mask_path;
   PhotoSegmenter::Options options;
   for (int i = 2; i < argc; ++i) {
