@@ -252,3 +252,20 @@ def test_calibration_keeps_the_model_of_a_station_where_a_sherd_lies(data):
     assert workflow.Calibrate(batch).run() == "done"
     assert "scale" not in calibrated
     assert {"camera", "discard", "pickup"} <= set(calibrated)
+
+
+def test_a_found_sherd_that_slips_from_the_first_grasp_is_grasped_again(data):
+    lookalike = _obs(0.21, 0.25, 0.054, 0.041)
+    batch = _dropped_on_the_way(data, {"pickup": [lookalike]})
+    closes = iter([False, True])
+    batch.rig.gripper.close = lambda: rig.GraspResult(next(closes), 0.04)
+    assert workflow.Recover(batch).run() == "held"
+
+
+def test_a_found_sherd_that_cannot_be_grasped_is_lost_after_the_attempts(data):
+    batch = _dropped_on_the_way(data, {"pickup": [_obs(0.21, 0.25, 0.054, 0.041)]})
+    tries = []
+    batch.rig.gripper.close = lambda: tries.append(1) or rig.GraspResult(False, 0.03)
+    assert workflow.Recover(batch).run() == "lost"
+    assert len(tries) == data["recovery"]["max_grasp_attempts"]
+    assert any(c[0] == "lost" and "could not be picked up" in c[2] for c in batch.recorder.calls)

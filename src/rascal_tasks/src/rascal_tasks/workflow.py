@@ -347,22 +347,15 @@ class Pickup(BatchState):
 
     def run(self):
         b = self.batch
-        o = b.pending.pop(0)
+        o, tries, held = grasp_retrying(b, b.pending.pop(0), b.pickup)
+        if held:
+            seq = b.recorder.new_sherd((o.x, o.y), attempts=tries)
+            b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - b.pickup.surface_z,
+                                      o.width, last_xy=(o.x, o.y), picked_xy=(o.x, o.y),
+                                      timings=b.timings)
+            b.recorder.dimensions(seq, o.length, o.width, o.height)
+            return "held"
         attempts = b.config["recovery"]["max_grasp_attempts"]
-        for attempt in range(attempts):
-            if grasp(b, o, b.pickup.surface_z):
-                seq = b.recorder.new_sherd((o.x, o.y), attempts=attempt + 1)
-                b.sherd = SherdInProgress(seq, o, o.grasp_yaw, o.grasp_z - b.pickup.surface_z,
-                                          o.width, last_xy=(o.x, o.y), picked_xy=(o.x, o.y),
-                                          timings=b.timings)
-                b.recorder.dimensions(seq, o.length, o.width, o.height)
-                return "held"
-            seen = b.survey_at(b.pickup, o.x, o.y)
-            near = [s for s in seen if s.distance_to(o.x, o.y) < b.config["recovery"][
-                "search_radius"]]
-            if not near:
-                break
-            o = min(near, key=lambda s: s.distance_to(o.x, o.y))
         b.pending = []  # the area changed under us: survey again
         key = (round(o.x, 2), round(o.y, 2))
         b.misses[key] = b.misses.get(key, 0) + 1
@@ -371,6 +364,25 @@ class Pickup(BatchState):
             b.event(None, "unpickable", "sherd at (%.3f, %.3f) m left in the pickup area after "
                     "%d failed grasps" % (o.x, o.y, 2 * attempts))
         return "missed"
+
+
+def grasp_retrying(b: Batch, o: Observation, station, like=None):
+    """Grasp `o` at `station`; after a miss, detect again around it and grasp the detection
+    nearest it (or least `like`), up to recovery.max_grasp_attempts in all.
+    Returns (the last observation tried, grasps made, whether it is held)."""
+    rec = b.config["recovery"]
+    like = like or (lambda c, last: c.distance_to(last.x, last.y))
+    for attempt in range(rec["max_grasp_attempts"]):
+        if grasp(b, o, station.surface_z):
+            return o, attempt + 1, True
+        if attempt + 1 == rec["max_grasp_attempts"]:
+            break
+        near = [c for c in b.survey_at(station, o.x, o.y)
+                if c.distance_to(o.x, o.y) < rec["search_radius"]]
+        if not near:
+            break
+        o = min(near, key=lambda c, last=o: like(c, last))
+    return o, attempt + 1, False
 
 
 def grasp(b: Batch, o: Observation, surface_z: float) -> bool:
@@ -532,9 +544,10 @@ class Recover(BatchState):
             return c.distance_to(*ref) + 4 * (abs(c.length - like.length)
                                               + abs(c.width - like.width))
 
-        o = min(candidates, key=unlikeness)
-        if not grasp(b, o, station.surface_z):
-            return lose(b, "found but could not be picked up")
+        o, tries, held = grasp_retrying(b, min(candidates, key=unlikeness), station,
+                                        like=lambda c, _last: unlikeness(c))
+        if not held:
+            return lose(b, "found but could not be picked up (%d grasps)" % tries)
         s.grasp_yaw, s.width = o.grasp_yaw, o.width
         s.grasp_height = o.grasp_z - station.surface_z
         if station is b.pickup and s.station_index < 0:
