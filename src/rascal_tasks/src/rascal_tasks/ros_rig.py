@@ -19,9 +19,9 @@ from rascal_msgs.srv import CalibrateBackground, CaptureArchival, Detect
 from rascal_tasks import rig
 
 SERVICE_WAIT = 30.0  # s (wall clock): how long a node may take to come up
-# Fingers closed on nothing stop at 30 mm (facts §1.4); a sherd keeps them at least a few mm
-# wider. Below this the gripper is taken to be empty.
-EMPTY_OPENING = 0.030 + 0.003
+# Fingers closed on nothing stop at 30 mm (facts §1.4); a sherd keeps them wider by at least the
+# arm controller's arm.gripper.held_margin, the same rule its close result uses.
+CLOSED_OPENING = 0.030
 FULLY_OPEN = 0.074 - 0.004
 CODE_NAMES = {1: "UNREACHABLE", 2: "COLLISION", 3: "TIMEOUT", 4: "PREEMPTED", 5: "INVALID_GOAL"}
 
@@ -97,7 +97,8 @@ class RosArm(rig.Arm):
 class RosGripper(rig.Gripper):
     """rascal_control.Gripper, plus the finger gap from /joint_states to notice a drop."""
 
-    def __init__(self):
+    def __init__(self, held_margin: float = 0.002):
+        self._empty_opening = CLOSED_OPENING + held_margin  # at or below: nothing in the fingers
         try:
             self._gripper = ControlGripper(wait=SERVICE_WAIT)
         except ControlError as e:
@@ -134,8 +135,8 @@ class RosGripper(rig.Gripper):
         if self._opening is None:
             return False
         if self._closed is None:  # after a restart: fingers neither open nor shut on nothing
-            return EMPTY_OPENING < self._opening < FULLY_OPEN
-        return self._opening > EMPTY_OPENING
+            return self._empty_opening < self._opening < FULLY_OPEN
+        return self._opening > self._empty_opening
 
     def width(self):
         return self._opening if self._opening is not None else 0.0

@@ -74,7 +74,7 @@ def run(context: str, dsn: str = None) -> int:
     try:
         recorder = Recorder(catalogue, archive, context, cfg["rig"]["site"],
                             log=rospy.loginfo)
-        rig = make_rig()
+        rig = make_rig(cfg)
     except (CatalogueError, RigError) as e:
         return fail(str(e), 3)
 
@@ -107,11 +107,12 @@ def run(context: str, dsn: str = None) -> int:
     return {"finished": 0, "preempted": 130}.get(outcome, 1)
 
 
-def make_rig() -> Rig:
+def make_rig(cfg) -> Rig:
     from rascal_tasks.ros_rig import (RosArchivalCamera, RosArm, RosClock, RosGripper,
                                       RosPerception, RosScale)
     clock = RosClock()
-    return Rig(arm=RosArm(), gripper=RosGripper(), perception=RosPerception(),
+    return Rig(arm=RosArm(), gripper=RosGripper(cfg["arm"]["gripper"]["held_margin"]),
+               perception=RosPerception(),
                scale=RosScale(clock), camera=RosArchivalCamera(), clock=clock)
 
 
