@@ -269,3 +269,25 @@ def test_a_found_sherd_that_cannot_be_grasped_is_lost_after_the_attempts(data):
     assert workflow.Recover(batch).run() == "lost"
     assert len(tries) == data["recovery"]["max_grasp_attempts"]
     assert any(c[0] == "lost" and "could not be picked up" in c[2] for c in batch.recorder.calls)
+
+
+def test_a_weighed_sherd_is_never_replaced_by_one_from_the_pickup_area(data):
+    # weighed already, so never above the pickup area again: a look-alike there is another sherd
+    batch = _dropped_on_the_way(data, {"pickup": [_obs(0.13, 0.25, 0.0545, 0.0405)]})
+    batch.sherd.station_index = 0
+    assert workflow.Recover(batch).run() == "lost"
+    assert "pickup" not in batch.rig.perception.views
+    # but on the station it was being carried to, it is found
+    camera = config_from_dict(data).stations["camera"]
+    batch = _dropped_on_the_way(data, {"camera": [_obs(*camera.place_at, 0.0545, 0.0405)]})
+    batch.sherd.station_index = 0
+    assert workflow.Recover(batch).run() == "held"
+    assert batch.rig.perception.views == ["scale", "camera"]
+
+
+def test_a_sherd_seen_off_the_station_is_left_for_a_person(data):
+    # it fell off the scale onto the table: another height than the pan, no grasp planned there
+    batch = _dropped_on_the_way(data, {"scale": [_obs(0.32, -0.12, 0.055, 0.040)]})
+    assert workflow.Recover(batch).run() == "lost"
+    notes = [c[2] for c in batch.recorder.calls if c[0] == "note"]
+    assert any("off the scale" in n and "(0.320, -0.120)" in n for n in notes), notes

@@ -66,9 +66,10 @@ class Rect:
                 and abs(self.center[1] - other.center[1]) * 2 < self.size[1] + other.size[1])
 
     def contains(self, other: "Rect") -> bool:
-        return all(self._has(c) for c in other.corners())
+        return all(self.has(c) for c in other.corners())
 
-    def _has(self, p) -> bool:
+    def has(self, p) -> bool:
+        """Whether the point p = (x, y) lies on the rectangle."""
         return (abs(p[0] - self.center[0]) <= self.size[0] / 2 + 1e-9
                 and abs(p[1] - self.center[1]) <= self.size[1] / 2 + 1e-9)
 
@@ -366,7 +367,7 @@ def _read_stations(sec: _Reader) -> Dict[str, Station]:
                 if not area.contains(extra[part].area):
                     st.fail(part, "must lie inside the camera's field of view %s" % (
                         _fmt_rect(area),), _fmt_rect(extra[part].area))
-            if not area._has(place_at):
+            if not area.has(place_at):
                 st.fail("place_at", "must lie inside the camera's field of view %s" % (
                     _fmt_rect(area),), list(place_at))
             if not top_down_reachable(place_at[0], place_at[1], surface_z):
@@ -414,7 +415,7 @@ def _read_arm(arm: _Reader, stations: Dict[str, Station]) -> dict:
     if not top_down_reachable(standby[0], standby[1], travel_z):
         arm.fail("standby", "outside the arm's top-down reach at travel_z", list(standby))
     cam = next(s for s in stations.values() if s.type == "archival_camera")
-    if cam.area._has(standby):
+    if cam.area.has(standby):
         arm.fail("standby", "inside the archival camera's view %s; the arm must park out of "
                  "view" % _fmt_rect(cam.area), list(standby))
     arm.number("speed_scale", 0.01, 1.0)

@@ -520,9 +520,12 @@ def lose(b: Batch, reason: str) -> str:
 
 
 class Recover(BatchState):
-    """A dropped sherd: look where it was last seen, then where it was picked up, then over the
-    whole pickup area (a grasp that slips while lifting drops it back there). Of what is found,
-    the one most like it (position, then size) is taken, so another sherd lying near is not."""
+    """A dropped sherd: look where it was last seen; then, if it was on its way from the pickup
+    area, where it was picked up and over the whole pickup area (a grasp that slips while lifting
+    drops it back there), or, if it was already measured, at the station it was carried to (it
+    was never above the pickup area again, and a sherd from there would put another sherd's
+    mass or photo in its row). Of what is found, the one most like it (position, then size) is
+    taken, so another sherd lying near is not; what lies off a station is left for a person."""
 
     def __init__(self, batch):
         super().__init__(batch, ["held", "lost"])
@@ -533,10 +536,10 @@ class Recover(BatchState):
         if s.drops > b.config["recovery"]["max_searches"]:
             return lose(b, "dropped %d times" % s.drops)
         station, candidates, ref = self.search(s)
-        if not candidates:
-            return lose(b, "not found where it was last seen (%s), nor in the pickup area"
-                        % s.where)
         like = s.observation
+        if not candidates:
+            return lose(b, "not found where it was last seen (%s)%s" % (
+                s.where, ", nor in the pickup area" if s.station_index < 0 else ""))
 
         def unlikeness(c):
             # A drop scatters a sherd by centimetres; its size is measured within ~3 mm, so a
@@ -548,6 +551,8 @@ class Recover(BatchState):
                                         like=lambda c, _last: unlikeness(c))
         if not held:
             return lose(b, "found but could not be picked up (%d grasps)" % tries)
+        b.event(s, "recovered", "picked up again at the %s, (%.3f, %.3f) m" % (
+            station.name, o.x, o.y))
         s.grasp_yaw, s.width = o.grasp_yaw, o.width
         s.grasp_height = o.grasp_z - station.surface_z
         if station is b.pickup and s.station_index < 0:
@@ -561,12 +566,27 @@ class Recover(BatchState):
         b = self.batch
         where = b.config.stations.get(s.where, b.pickup)
         places = [(where, s.last_xy)]
-        if s.picked_xy is not None and (where is not b.pickup or s.picked_xy != s.last_xy):
+        if s.station_index >= 0:
+            # Lifted from a station after it was measured: it was never above the pickup area
+            # again. It fell where it was lifted, or where it was carried to.
+            nxt = s.station_index + 1
+            if nxt < len(b.plugins) and b.plugins[nxt].station is not where:
+                places.append((b.plugins[nxt].station, b.plugins[nxt].station.place_at))
+        elif s.picked_xy is not None and (where is not b.pickup or s.picked_xy != s.last_xy):
             places.append((b.pickup, s.picked_xy))
         for station, xy in places:
             seen = b.survey_at(station, *xy)
-            if seen:
-                return station, seen, xy
+            # What the wrist camera sees beyond the station (the table around the scale) lies
+            # at another height than the station's surface the grasp is planned from.
+            on = [o for o in seen if station.area.has((o.x, o.y))]
+            for o in seen:
+                if o not in on:
+                    b.event(s, "seen_off_station", "a sherd at (%.3f, %.3f) m, off the %s: "
+                            "left for a person" % (o.x, o.y, station.name))
+            if on:
+                return station, on, xy
+        if s.station_index >= 0:
+            return where, [], s.last_xy
         return b.pickup, b.survey_pickup_area(), s.picked_xy or s.last_xy
 
 
