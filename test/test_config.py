@@ -75,7 +75,7 @@ BAD = [
     ("recovery.max_grasp_attempts", 0, "recovery.max_grasp_attempts: expected an integer"),
     ("simulator.mat_colour", [0, 0, 2], "simulator.mat_colour: expected [r, g, b]"),
     ("simulator.scale_colours", [[0, 0, 0]], "simulator.scale_colours: expected two"),
-    ("simulator.archival_size", [640, 480], "simulator.archival_size: expected at least"),
+    ("simulator.archival_size", [640, 480], "simulator.archival_size: expected [width, height] of at least"),
     ("simulator.wrist_camera", "yes", "simulator.wrist_camera: expected true or false"),
     ("survey.stepp", 0.1, "survey.stepp: unknown key"),
 ]

@@ -12,11 +12,13 @@
 
 namespace rascal_workcell {
 
-enum class StationType { Pickup, Scale, ArchivalCamera, Discard };
+/// Other: a station type of a task-layer plug-in (a profile scanner): a place on the table the
+/// nodes know by its area and surface only.
+enum class StationType { Pickup, Scale, ArchivalCamera, Discard, Other };
 
 /// "pickup" | "scale" | "archival_camera" | "discard" (the config's `type`).
 std::string toString(StationType type);
-StationType stationTypeFromString(const std::string& name);  ///< throws std::invalid_argument
+StationType stationTypeFromString(const std::string& name);  ///< Other for any other name
 
 /// A rectangle on the table: centre and size [along x, along y] in base_link, metres.
 struct TableRect {

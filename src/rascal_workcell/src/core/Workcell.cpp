@@ -10,6 +10,7 @@ std::string toString(StationType type) {
     case StationType::Scale: return "scale";
     case StationType::ArchivalCamera: return "archival_camera";
     case StationType::Discard: return "discard";
+    case StationType::Other: return "other";
   }
   return "unknown";
 }
@@ -19,7 +20,7 @@ StationType stationTypeFromString(const std::string& name) {
                         StationType::Discard}) {
     if (toString(t) == name) return t;
   }
-  throw std::invalid_argument("unknown station type '" + name + "'");
+  return StationType::Other;
 }
 
 bool TableRect::contains(const Eigen::Vector2d& p) const {
@@ -119,6 +120,7 @@ std::vector<FixtureBox> Workcell::collisionBoxes() const {
                          {s.stand.size.x(), s.stand.size.y(), s.stand_height}, false});
         break;
       case StationType::Pickup:
+      case StationType::Other:
         break;  // a mat on the table
     }
   }
