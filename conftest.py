@@ -7,72 +7,17 @@
   that `scripts/setup.sh` started.
 """
 import os
-import shutil
-import signal
-import socket
 import subprocess
-import tempfile
-import time
 import uuid
 
 import pytest
+
+from rascal_tasks.sim_rig import RosMaster, stop
 
 WORKSPACE = os.path.dirname(os.path.abspath(__file__))
 CONFIG = os.path.join(WORKSPACE, "config", "rascal.yaml")
 PG_ADMIN_DSN = os.environ.get(
     "RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0.1:5432/rascal")
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _stop(proc, timeout=10.0):
-    """SIGINT the whole process group (as Ctrl-C would), then SIGKILL what is left."""
-    if proc.poll() is not None:
-        return
-    try:
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(timeout=timeout)
-    except (subprocess.TimeoutExpired, ProcessLookupError):
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-        proc.wait()
-
-
-class RosMaster:
-    """A roscore on a free port; `env` is what child processes need to talk to it."""
-
-    def __init__(self):
-        self.port = free_port()
-        self.log_dir = tempfile.mkdtemp(prefix="rascal_roslog_")
-        self.uri = "http://127.0.0.1:%d" % self.port
-        self.env = dict(os.environ, ROS_MASTER_URI=self.uri, ROS_LOG_DIR=self.log_dir,
-                        ROS_HOSTNAME="127.0.0.1", ROS_HOME=self.log_dir, PYTHONUNBUFFERED="1")
-        self.env.pop("ROS_IP", None)
-        self.proc = subprocess.Popen(["roscore", "-p", str(self.port)], env=self.env,
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT,
-                                     start_new_session=True)
-        deadline = time.monotonic() + 30.0
-        while time.monotonic() < deadline:
-            if self.run(["rosparam", "get", "/run_id"], check=False).returncode == 0:
-                return
-            time.sleep(0.2)
-        self.stop()
-        raise RuntimeError("roscore did not come up on port %d" % self.port)
-
-    def run(self, cmd, check=True, timeout=60.0, **kw):
-        """Run a command against this master and wait for it (rosparam, rosservice, ...)."""
-        return subprocess.run(cmd, env=self.env, capture_output=True, text=True, check=check,
-                              timeout=timeout, **kw)
-
-    def stop(self):
-        _stop(self.proc)
-        shutil.rmtree(self.log_dir, ignore_errors=True)
 
 
 class Rosrun:
@@ -93,7 +38,7 @@ class Rosrun:
 
     def stop_all(self):
         for p in reversed(self.procs):
-            _stop(p)
+            stop(p)
 
 
 @pytest.fixture(scope="session")

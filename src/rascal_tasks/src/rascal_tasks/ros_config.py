@@ -9,10 +9,12 @@ import os
 import rospkg
 import rospy
 
+from rascal_workcell import schema
+
 from rascal_tasks.config import Config, ConfigError, config_from_dict
 
-SECTIONS = ("rig", "stations", "arm", "survey", "perception", "scale", "recovery", "database",
-            "archive", "simulator")
+# The top-level sections of config/rascal.yaml, as the parameter schema lists them.
+SECTIONS = tuple(schema.builtin().sections(""))
 
 
 def workspace_root() -> str:

@@ -52,6 +52,39 @@ def stop(proc, timeout=10.0):
         proc.wait()
 
 
+class RosMaster:
+    """A roscore on a free port with its own log folder; `env` is what child processes need to
+    talk to it. The tests' `ros_master` fixture and SimRig both use it."""
+
+    def __init__(self, log_dir=None, timeout=30.0):
+        self.port = free_port()
+        self.own_log_dir = log_dir is None
+        self.log_dir = log_dir or tempfile.mkdtemp(prefix="rascal_roslog_")
+        self.uri = "http://127.0.0.1:%d" % self.port
+        self.env = dict(os.environ, ROS_MASTER_URI=self.uri, ROS_LOG_DIR=self.log_dir,
+                        ROS_HOSTNAME="127.0.0.1", ROS_HOME=self.log_dir, PYTHONUNBUFFERED="1")
+        self.env.pop("ROS_IP", None)
+        self.proc = subprocess.Popen(["roscore", "-p", str(self.port)], env=self.env,
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT,
+                                     start_new_session=True)
+        deadline = time.monotonic() + timeout
+        while self.run(["rosparam", "get", "/run_id"], check=False).returncode != 0:
+            if time.monotonic() > deadline or self.proc.poll() is not None:
+                self.stop()
+                raise RuntimeError("roscore did not come up on port %d" % self.port)
+            time.sleep(0.2)
+
+    def run(self, cmd, check=True, timeout=60.0, **kw):
+        """Run a command against this master and wait for it (rosparam, rosservice, ...)."""
+        return subprocess.run(cmd, env=self.env, capture_output=True, text=True, check=check,
+                              timeout=timeout, **kw)
+
+    def stop(self):
+        stop(self.proc)
+        if self.own_log_dir:
+            shutil.rmtree(self.log_dir, ignore_errors=True)
+
+
 class SimRig:
     """The simulated rig. `env` talks to its master; `params` are set after the config."""
 
@@ -62,18 +95,10 @@ class SimRig:
         self.own_log_dir = log_dir is None
         self.log_dir = log_dir or tempfile.mkdtemp(prefix="rascal_sim_rig_")
         self.logs = {}
+        self.master = None
         if master_env is None:
-            port = free_port()
-            self.env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port,
-                            ROS_HOSTNAME="127.0.0.1", ROS_LOG_DIR=self.log_dir,
-                            ROS_HOME=self.log_dir, PYTHONUNBUFFERED="1")
-            self.env.pop("ROS_IP", None)
-            self.procs.append(self._spawn("roscore", ["roscore", "-p", str(port)]))
-            deadline = time.monotonic() + 30.0
-            while self.run(["rosparam", "get", "/run_id"], check=False).returncode != 0:
-                if time.monotonic() > deadline:
-                    raise RuntimeError("roscore did not start")
-                time.sleep(0.2)
+            self.master = RosMaster(log_dir=self.log_dir)
+            self.env = self.master.env
         else:
             self.env = dict(master_env)
         try:
@@ -139,6 +164,9 @@ class SimRig:
         for p in reversed(self.procs):
             stop(p)
         self.procs = []
+        if self.master is not None:
+            self.master.stop()
+            self.master = None
         if self.own_log_dir and os.environ.get("RASCAL_KEEP_LOGS") is None:
             shutil.rmtree(self.log_dir, ignore_errors=True)
 

@@ -11,7 +11,7 @@ import difflib
 import math
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional
+from typing import Any, List, Optional
 
 import yaml
 
