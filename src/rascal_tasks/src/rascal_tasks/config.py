@@ -174,7 +174,7 @@ def config_from_dict(data, source="config/rascal.yaml", workspace=".") -> Config
 
 
 def _check_joints(source: str, key: str, q):
-    for name, v, (lo, hi) in zip(ARM_JOINTS, q, urdf_limits.arm_joint_limits()):
+    for name, v, (lo, hi) in zip(ARM_JOINTS, q, urdf_limits.arm_joint_limits(), strict=False):
         if not lo <= v <= hi:
             _fail(source, key, "%s = %g rad is outside its URDF limits [%g, %g]" % (
                 name, v, lo, hi), list(q))
