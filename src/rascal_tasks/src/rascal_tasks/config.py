@@ -23,16 +23,17 @@ from typing import Dict, List, Optional, Tuple
 
 import yaml
 
-from rascal_workcell import schema, urdf_limits
+from rascal_workcell import schema, urdf_model
 
 from rascal_tasks.stations import STATION_PLUGINS
 from rascal_tasks.survey import lawnmower
 
-# --- wx250s geometry for the reach check (shared/facts/widowx250_d435.md §1.1, §1.5) -------------
-SHOULDER_Z = 0.11065  # shoulder axis above base_link: 0.072 + 0.03865
-UPPER_ARM = math.hypot(0.25, 0.04975)  # shoulder axis -> elbow axis, 0.25490
-FOREARM = 0.175 + 0.075  # elbow axis -> wrist_angle axis
-WRIST_TO_EE = 0.065 + 0.043 + 0.023 + 0.027575  # wrist_angle axis -> ee_gripper_link, 0.158575
+# --- wx250s geometry for the reach check, from the URDF (rascal_description) ---------------------
+_ARM = urdf_model.arm_geometry()
+SHOULDER_Z = _ARM.shoulder_z  # shoulder axis above base_link
+UPPER_ARM = _ARM.upper_arm  # shoulder axis -> elbow axis
+FOREARM = _ARM.forearm  # elbow axis -> wrist_angle axis
+WRIST_TO_EE = _ARM.wrist_to_ee  # wrist_angle axis -> ee_gripper_link
 # Stretched-out arm is singular and slow; keep 5 % in hand. Over the base the waist spins fast
 # for small moves and the forearm hits the base: stay 10 cm out.
 MAX_WRIST_DISTANCE = 0.95 * (UPPER_ARM + FOREARM)
@@ -40,7 +41,7 @@ MIN_RADIUS = 0.10
 
 # Every station type with a plug-in (stations.py) can appear in the config; these four must.
 REQUIRED_STATION_TYPES = ("pickup", "scale", "archival_camera", "discard")
-ARM_JOINTS = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
+ARM_JOINTS = urdf_model.ARM_JOINTS
 
 
 class ConfigError(ValueError):
@@ -166,7 +167,7 @@ def config_from_dict(data, source="config/rascal.yaml", workspace=".") -> Config
               "port/dbname) or key=value string", dsn)
     sim = checked["simulator"]
     _check_joints(source, "simulator.initial_joints", sim["initial_joints"])
-    lo, hi = urdf_limits.finger_limits()
+    lo, hi = urdf_model.finger_limits()
     if not lo <= sim["initial_finger"] <= hi:
         _fail(source, "simulator.initial_finger", "expected a number in metres in [%g, %g] (the "
               "URDF's finger limits)" % (lo, hi), sim["initial_finger"])
@@ -174,7 +175,7 @@ def config_from_dict(data, source="config/rascal.yaml", workspace=".") -> Config
 
 
 def _check_joints(source: str, key: str, q):
-    for name, v, (lo, hi) in zip(ARM_JOINTS, q, urdf_limits.arm_joint_limits(), strict=False):
+    for name, v, (lo, hi) in zip(ARM_JOINTS, q, urdf_model.arm_joint_limits(), strict=False):
         if not lo <= v <= hi:
             _fail(source, key, "%s = %g rad is outside its URDF limits [%g, %g]" % (
                 name, v, lo, hi), list(q))
