@@ -1,5 +1,6 @@
 """Core tests of the station workflow's structure (no master, no rig): the machine is built
 from the config's stations, and a new station type is a class plus a config entry."""
+
 import copy
 import os
 
@@ -7,8 +8,14 @@ import pytest
 import yaml
 
 from rascal_tasks import rig, stations, workflow
+from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING, opening_for
+from rascal_tasks.recovery import Recover
+from rascal_tasks.resume import PUT_BACK_HEIGHT, Calibrate, Home, Resume
+from rascal_tasks.selection import in_pick_order
+from rascal_tasks.sherd_record import SherdRecord
+from rascal_tasks.station_states import AtStation
 from rascal_tasks.config import config_from_dict
-from rascal_tasks.survey import lawnmower
+from rascal_tasks.survey import lawnmower, merge
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
@@ -28,8 +35,9 @@ class _Clock(rig.Clock):
 
 
 def _batch(cfg):
-    r = rig.Rig(rig.Arm(), rig.Gripper(), rig.Perception(), rig.Scale(), rig.ArchivalCamera(),
-                _Clock())
+    r = rig.Rig(
+        rig.Arm(), rig.Gripper(), rig.Perception(), rig.Scale(), rig.ArchivalCamera(), _Clock()
+    )
     return workflow.Batch(cfg, r, recorder=None, context="T")
 
 
@@ -38,10 +46,13 @@ def test_machine_visits_the_stations_in_config_order(data):
     labels = set(sm.get_children())
     assert {"TRANSLATE_0", "PLACE_0", "STATION_0", "REPICK_0", "TRANSLATE_2"} <= labels
     assert "REPICK_2" not in labels  # nothing is picked up from the discard box
-    assert isinstance(sm.get_children()["STATION_0"], workflow.AtStation)
+    assert isinstance(sm.get_children()["STATION_0"], AtStation)
     b = sm.get_children()["STATION_0"].batch
     assert [type(p).__name__ for p in b.plugins] == [
-        "ScaleStation", "ArchivalCameraStation", "DiscardStation"]
+        "ScaleStation",
+        "ArchivalCameraStation",
+        "DiscardStation",
+    ]
 
 
 def test_every_state_outcome_is_wired(data):
@@ -63,8 +74,12 @@ def test_a_new_station_type_is_a_class_and_a_config_entry(data, monkeypatch):
 
     d = copy.deepcopy(data)
     order = list(d["stations"].items())
-    scanner = {"type": "profile_scanner", "position": [0.38, 0.12], "size": [0.08, 0.08],
-               "surface_z": 0.01}
+    scanner = {
+        "type": "profile_scanner",
+        "position": [0.38, 0.12],
+        "size": [0.08, 0.08],
+        "surface_z": 0.01,
+    }
     d["stations"] = dict(order[:2] + [("scanner", scanner)] + order[2:])
     cfg = config_from_dict(d)
     assert cfg.station_order() == ["scale", "scanner", "camera", "discard"]
@@ -82,15 +97,16 @@ def test_unknown_station_type_is_refused(data):
 
 
 def test_opening_is_clamped_to_the_gripper():
-    assert workflow.opening_for(0.010, 0.012) == workflow.MIN_OPENING
-    assert workflow.opening_for(0.040, 0.012) == pytest.approx(0.052)
-    assert workflow.opening_for(0.070, 0.012) == workflow.MAX_OPENING
+    assert opening_for(0.010, 0.012) == MIN_OPENING
+    assert opening_for(0.040, 0.012) == pytest.approx(0.052)
+    assert opening_for(0.070, 0.012) == MAX_OPENING
 
 
 def test_detections_from_two_survey_poses_are_merged():
     def obs(x, y):
         return rig.Observation(x, y, 0, 0.04, 0.03, 0.01, x, y, 0.01, 0, 0.045)
-    merged = workflow._merge([obs(0.10, 0.20)], [obs(0.105, 0.20), obs(0.20, 0.25)])
+
+    merged = merge([obs(0.10, 0.20)], [obs(0.105, 0.20), obs(0.20, 0.25)])
     assert [(o.x, o.y) for o in merged] == [(0.10, 0.20), (0.20, 0.25)]
 
 
@@ -152,14 +168,16 @@ def _dropped_on_the_way(data, world):
     """A sherd picked at (0.12, 0.25), carried to the scale, not there after placing."""
     cfg = config_from_dict(data)
     arm = _Arm()
-    r = rig.Rig(arm, _Gripper(), _Perception(arm, world), rig.Scale(), rig.ArchivalCamera(),
-                _Clock())
+    r = rig.Rig(
+        arm, _Gripper(), _Perception(arm, world), rig.Scale(), rig.ArchivalCamera(), _Clock()
+    )
     batch = workflow.Batch(cfg, r, recorder=_Recorder(), context="T")
     picked = _obs(0.12, 0.25, 0.055, 0.040)
     scale = cfg.stations["scale"]
-    batch.sherd = workflow.SherdInProgress(4, picked, 0.0, 0.005, 0.040, where="scale",
-                                           last_xy=tuple(scale.place_at), picked_xy=(0.12, 0.25),
-                                           drops=1)
+    s = batch.sherd = SherdRecord(batch, 4)
+    s.seen(picked, batch.pickup)
+    s.picked_xy, s.drops = (0.12, 0.25), 1
+    s.placed(scale)
     return batch
 
 
@@ -167,7 +185,7 @@ def test_a_sherd_lost_on_the_way_is_found_in_the_pickup_area_by_its_likeness(dat
     # It fell 9 cm from where it was picked; a smaller sherd lies closer to that spot.
     lookalike, other = _obs(0.21, 0.25, 0.054, 0.041), _obs(0.16, 0.25, 0.030, 0.025)
     batch = _dropped_on_the_way(data, {"pickup": [other, lookalike]})
-    assert workflow.Recover(batch).run() == "held"
+    assert Recover(batch).run() == "held"
     assert batch.rig.arm.at == (lookalike.grasp_x, lookalike.grasp_y)
     assert batch.sherd.where == "pickup" and batch.sherd.observation is lookalike
     assert ("dimensions", 4, 0.054, 0.041, 0.01) in batch.recorder.calls
@@ -177,7 +195,7 @@ def test_a_sherd_lost_on_the_way_is_found_in_the_pickup_area_by_its_likeness(dat
 
 def test_a_sherd_found_nowhere_is_recorded_lost_and_the_batch_goes_on(data):
     batch = _dropped_on_the_way(data, {})
-    assert workflow.Recover(batch).run() == "lost"
+    assert Recover(batch).run() == "lost"
     lost = [c for c in batch.recorder.calls if c[0] == "lost"]
     assert lost and lost[0][1] == 4 and "pickup area" in lost[0][2]
     assert batch.sherd is None and batch.lost == 1
@@ -194,8 +212,9 @@ class _Restarted(_Recorder):
 def _restarted_batch(data, world):
     cfg = config_from_dict(data)
     arm = _Arm()
-    r = rig.Rig(arm, _Gripper(), _Perception(arm, world), rig.Scale(), rig.ArchivalCamera(),
-                _Clock())
+    r = rig.Rig(
+        arm, _Gripper(), _Perception(arm, world), rig.Scale(), rig.ArchivalCamera(), _Clock()
+    )
     return workflow.Batch(cfg, r, recorder=_Restarted(), context="T")
 
 
@@ -203,22 +222,27 @@ def test_a_sherd_in_the_fingers_after_a_restart_is_set_down_and_carried_on(data)
     batch = _restarted_batch(data, {"pickup": [_obs(0.151, 0.221, 0.05, 0.04)]})
     moves = []
     move = batch.rig.arm.move_down
-    batch.rig.arm.move_down = lambda x, y, z, yaw, linear=False: (moves.append((x, y, z)),
-                                                                  move(x, y, z, yaw))[1]
-    assert workflow.Home(batch).run() == "done"
+    batch.rig.arm.move_down = lambda x, y, z, yaw, linear=False: (
+        moves.append((x, y, z)),
+        move(x, y, z, yaw),
+    )[1]
+    assert Home(batch).run() == "done"
     # set down at its pickup spot, low over the mat, before anything else
-    assert moves[0][:2] == (0.15, 0.22) and moves[1] == (0.15, 0.22, workflow.PUT_BACK_HEIGHT
-                                                         + batch.pickup.surface_z)
+    assert moves[0][:2] == (0.15, 0.22) and moves[1] == (
+        0.15,
+        0.22,
+        PUT_BACK_HEIGHT + batch.pickup.surface_z,
+    )
     assert batch.put_back == (2, 0.15, 0.22)
     # weighed already: picked up again and carried to the next station (the camera)
-    assert workflow.Resume(batch).run() == "TRANSLATE_1"
+    assert Resume(batch).run() == "TRANSLATE_1"
     assert batch.sherd.seq == 2 and batch.sherd.station_index == 0
 
 
 def test_an_empty_gripper_after_a_restart_is_only_opened(data):
     batch = _restarted_batch(data, {})
     batch.rig.gripper.close = lambda: rig.GraspResult(False, 0.03)
-    assert workflow.Home(batch).run() == "done"
+    assert Home(batch).run() == "done"
     assert batch.put_back is None
     assert batch.rig.arm.at == tuple(batch.pickup.area.center)
 
@@ -228,10 +252,10 @@ def test_the_selection_policies_order_the_merged_survey():
     b = _obs(0.30, 0.30, 0.060, 0.045)  # largest, far from the others
     c = _obs(0.16, 0.20, 0.045, 0.035)  # close beside a
     found = [c, b, a]
-    assert workflow.in_pick_order(found, "nearest") == [a, c, b]
-    assert workflow.in_pick_order(found, "largest") == [b, c, a]
-    assert workflow.in_pick_order(found, "most_isolated")[0] is b
-    assert workflow.in_pick_order([a], "most_isolated") == [a]
+    assert in_pick_order(found, "nearest") == [a, c, b]
+    assert in_pick_order(found, "largest") == [b, c, a]
+    assert in_pick_order(found, "most_isolated")[0] is b
+    assert in_pick_order([a], "most_isolated") == [a]
 
 
 def test_calibration_keeps_the_model_of_a_station_where_a_sherd_lies(data):
@@ -249,7 +273,7 @@ def test_calibration_keeps_the_model_of_a_station_where_a_sherd_lies(data):
 
     r = rig.Rig(_Arm(), _Gripper(), Perception(), rig.Scale(), rig.ArchivalCamera(), _Clock())
     batch = workflow.Batch(cfg, r, recorder=_Recorder(), context="T")
-    assert workflow.Calibrate(batch).run() == "done"
+    assert Calibrate(batch).run() == "done"
     assert "scale" not in calibrated
     assert {"camera", "discard", "pickup"} <= set(calibrated)
 
@@ -259,14 +283,14 @@ def test_a_found_sherd_that_slips_from_the_first_grasp_is_grasped_again(data):
     batch = _dropped_on_the_way(data, {"pickup": [lookalike]})
     closes = iter([False, True])
     batch.rig.gripper.close = lambda: rig.GraspResult(next(closes), 0.04)
-    assert workflow.Recover(batch).run() == "held"
+    assert Recover(batch).run() == "held"
 
 
 def test_a_found_sherd_that_cannot_be_grasped_is_lost_after_the_attempts(data):
     batch = _dropped_on_the_way(data, {"pickup": [_obs(0.21, 0.25, 0.054, 0.041)]})
     tries = []
     batch.rig.gripper.close = lambda: tries.append(1) or rig.GraspResult(False, 0.03)
-    assert workflow.Recover(batch).run() == "lost"
+    assert Recover(batch).run() == "lost"
     assert len(tries) == data["recovery"]["max_grasp_attempts"]
     assert any(c[0] == "lost" and "could not be picked up" in c[2] for c in batch.recorder.calls)
 
@@ -275,19 +299,19 @@ def test_a_weighed_sherd_is_never_replaced_by_one_from_the_pickup_area(data):
     # weighed already, so never above the pickup area again: a look-alike there is another sherd
     batch = _dropped_on_the_way(data, {"pickup": [_obs(0.13, 0.25, 0.0545, 0.0405)]})
     batch.sherd.station_index = 0
-    assert workflow.Recover(batch).run() == "lost"
+    assert Recover(batch).run() == "lost"
     assert "pickup" not in batch.rig.perception.views
     # but on the station it was being carried to, it is found
     camera = config_from_dict(data).stations["camera"]
     batch = _dropped_on_the_way(data, {"camera": [_obs(*camera.place_at, 0.0545, 0.0405)]})
     batch.sherd.station_index = 0
-    assert workflow.Recover(batch).run() == "held"
+    assert Recover(batch).run() == "held"
     assert batch.rig.perception.views == ["scale", "camera"]
 
 
 def test_a_sherd_seen_off_the_station_is_left_for_a_person(data):
     # it fell off the scale onto the table: another height than the pan, no grasp planned there
     batch = _dropped_on_the_way(data, {"scale": [_obs(0.32, -0.12, 0.055, 0.040)]})
-    assert workflow.Recover(batch).run() == "lost"
+    assert Recover(batch).run() == "lost"
     notes = [c[2] for c in batch.recorder.calls if c[0] == "note"]
     assert any("off the scale" in n and "(0.320, -0.120)" in n for n in notes), notes

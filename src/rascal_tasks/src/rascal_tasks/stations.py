@@ -3,8 +3,10 @@
 A station type is a class registered under the `type` used in config/rascal.yaml; the workflow
 builds its states from the config's station list, so a new kind of station (a profile scanner,
 a second camera) is a new class here plus a config entry, not an edit of the state machine.
-No ROS here: plug-ins use the rig interfaces (`rig.py`) and the batch's recorder.
+No ROS here: plug-ins use the rig interfaces (`rig.py`) and write through the sherd's record
+(`sherd_record.py`).
 """
+
 import math
 from typing import Dict, Type
 
@@ -40,16 +42,20 @@ class StationPlugin:
 
     def __init__(self, station, batch):
         self.station = station  # rascal_tasks.config.Station
-        self.batch = batch  # rascal_tasks.workflow.Batch
+        self.batch = batch  # rascal_tasks.batch.Batch
 
     def before_place(self, sherd) -> None:
-        """Called with the sherd in the gripper above the station (e.g. tare the scale)."""
+        """Called with the sherd (a SherdRecord) in the gripper above the station (e.g. tare
+        the scale)."""
 
     def after_place(self, sherd) -> str:
-        """Called with the sherd placed and the gripper back at travel height. Returns 'done';
-        'missing' when the sherd is evidently not there (it is searched for like a drop); or
-        'failed' when the station could not do its job: the batch then parks the arm with the
-        catalogue consistent, for a person to look (a restart resumes this sherd)."""
+        """Called with the sherd placed and the gripper back at travel height; records what it
+        measured through `sherd` (SherdRecord). Returns 'done'; 'missing' when the sherd is
+        evidently not there (it is searched for like a drop); or 'failed' when the station could
+        not do its job for this sherd. A failed sherd that lies where the next sherd is placed
+        stops the batch with the arm parked, unfinished, for a person to look (a restart
+        resumes it); elsewhere (the discard box) it is recorded lost and the batch goes on
+        (`failures.classify`). A RigError raised here stops the batch."""
         raise NotImplementedError
 
 
@@ -70,16 +76,19 @@ class ScaleStation(StationPlugin):
                 reading = self.batch.rig.scale.read_stable(cfg["stable_timeout"])
                 if reading.stable:
                     break
-                self.batch.event(sherd, "scale_unstable", "attempt %d: %.1f g" % (
-                    attempt + 1, reading.mass * 1000))
+                self.batch.event(
+                    sherd,
+                    "scale_unstable",
+                    "attempt %d: %.1f g" % (attempt + 1, reading.mass * 1000),
+                )
         if reading.mass < MIN_SHERD_MASS:
             # Nothing on the pan: the sherd slipped away unnoticed on the way; look for it.
-            self.batch.event(sherd, "scale_empty", "reads %.1f g after placing the sherd" % (
-                reading.mass * 1000))
+            self.batch.event(
+                sherd, "scale_empty", "reads %.1f g after placing the sherd" % (reading.mass * 1000)
+            )
             return "missing"
-        sherd.mass = reading.mass
         # An unstable last reading is still recorded, and flagged in the sherd's notes.
-        self.batch.recorder.mass(sherd.seq, reading.mass, reading.stable)
+        sherd.record_mass(reading.mass, reading.stable)
         return "done"
 
 
@@ -98,22 +107,23 @@ class ArchivalCameraStation(StationPlugin):
         with b.phase("data_collection"):
             for attempt in range(self.CAPTURE_ATTEMPTS):
                 try:
-                    capture = b.rig.camera.capture(b.recorder.spool_path(sherd.seq))
+                    capture = b.rig.camera.capture(sherd.spool_path())
                     break
                 except RigError as e:
                     b.event(sherd, "capture_failed", "attempt %d: %s" % (attempt + 1, e.reason))
                     b.rig.clock.sleep(1.0)
             else:
-                return "failed"
-            b.recorder.photo(sherd.seq, capture.path)
+                return "failed"  # it lies on the camera's spot: the batch stops
+            sherd.record_photo(capture.path)
         return "done"
 
 
 @station_type("discard")
 class DiscardStation(StationPlugin):
+    """Nothing to measure: the sherd is done once it is in the box (the last station)."""
+
     status = "done"
     release_from_above = True
 
     def after_place(self, sherd):
-        self.batch.recorder.done(sherd.seq, timings=sherd.timings.as_dict())
         return "done"

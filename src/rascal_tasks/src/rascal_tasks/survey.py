@@ -1,10 +1,26 @@
-"""Lawnmower (boustrophedon) survey poses over a station rectangle. No ROS in here."""
+"""Looking for sherds with the wrist camera: the lawnmower over the pickup area, its views merged,
+and the states SURVEY and SURVEY_NEXT. No ROS in here.
+"""
+
 import math
 from typing import List, Tuple
 
+from rascal_workcell import urdf_model
 
-def lawnmower(center: Tuple[float, float], size: Tuple[float, float],
-              step: float) -> List[Tuple[float, float]]:
+from rascal_tasks.batch import BatchState
+from rascal_tasks.rig import Observation
+from rascal_tasks.selection import in_pick_order
+
+# Wrist camera offset from ee_gripper_link when the gripper points down, along the gripper's
+# yaw direction (camera_link sits 0.055 m "above" gripper_link in the URDF).
+CAMERA_OFFSET = urdf_model.camera_offset()
+# Two detections closer than this are the same sherd seen from two survey poses.
+SAME_SHERD = 0.02
+
+
+def lawnmower(
+    center: Tuple[float, float], size: Tuple[float, float], step: float
+) -> List[Tuple[float, float]]:
     """Camera positions [x, y] that cover the rectangle in cells no larger than `step`.
 
     Cells are spread evenly over the rectangle (the paper's grid started at a corner and
@@ -20,3 +36,67 @@ def lawnmower(center: Tuple[float, float], size: Tuple[float, float],
         ys = [y0 + (j + 0.5) * size[1] / ny for j in range(ny)]
         poses.extend((x, y) for y in (ys if i % 2 == 0 else reversed(ys)))
     return poses
+
+
+def camera_over(b, station, x, y):
+    """Put the wrist camera over (x, y) of a station, at the survey height."""
+    yaw = math.atan2(y, x)
+    ex, ey = x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw)
+    b.move_down(ex, ey, station.surface_z + b.config["survey"]["z"], yaw)
+
+
+def survey_at(b, station, x, y) -> List[Observation]:
+    """Put the wrist camera over (x, y) of a station and detect what is there."""
+    camera_over(b, station, x, y)
+    with b.phase("perception"):
+        b.rig.clock.sleep(b.config["survey"]["settle_time"])
+        return b.rig.perception.detect(station.name)
+
+
+def merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
+    """Add to `found` the detections of `new` that are not a sherd already in it."""
+    for o in new:
+        if all(o.distance_to(p.x, p.y) > SAME_SHERD for p in found):
+            found.append(o)
+    return found
+
+
+def survey_pickup_area(b) -> List[Observation]:
+    """The lawnmower over the pickup area, views merged. Sherds the gripper failed on
+    again and again are left out: they stay where they are, for a person."""
+    found: List[Observation] = []
+    for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size, b.config["survey"]["step"]):
+        merge(found, survey_at(b, b.pickup, x, y))
+    return [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)]
+
+
+class Survey(BatchState):
+    """Survey the pickup area and queue what is there in the order of the selection policy."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["found", "empty"])
+
+    def run(self):
+        b = self.batch
+        found = survey_pickup_area(b)
+        if not found:
+            b.empty_surveys += 1
+            if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
+                return "empty"
+            return self.run()
+        b.empty_surveys = 0
+        b.pending = in_pick_order(found, b.config["perception"]["selection_policy"])
+        return "found"
+
+
+class NextSherd(BatchState):
+    """After a sherd: take the next one already seen, or survey again."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["pickup", "survey"])
+
+    def label(self):
+        return "Next sherd"
+
+    def run(self):
+        return "pickup" if self.batch.pending else "survey"

@@ -51,7 +51,7 @@ class Spec:
 
     def matches(self, key: str) -> bool:
         a, b = self.key.split("."), key.split(".")
-        return len(a) == len(b) and all(p in ("*", k) for p, k in zip(a, b))
+        return len(a) == len(b) and all(p in ("*", k) for p, k in zip(a, b, strict=True))
 
     def range_text(self) -> str:
         def show(b, inf):
@@ -117,7 +117,7 @@ class Schema:
 
 def _prefix_matches(parts: List[str], prefix: str) -> bool:
     want = prefix.split(".") if prefix else []
-    return len(parts) == len(want) and all(p in ("*", k) for p, k in zip(parts, want))
+    return len(parts) == len(want) and all(p in ("*", k) for p, k in zip(parts, want, strict=True))
 
 
 _SCHEMA: Optional[Schema] = None

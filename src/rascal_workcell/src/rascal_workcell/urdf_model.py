@@ -1,6 +1,6 @@
-"""Joint limits, gripper limits and the arm's link lengths read from the URDF (rascal_description/urdf/wx250s.urdf), so no Python
-module writes them down again. The C++ side reads the same file (rascal_workcell::GripperGeometry,
-rascal_control::KinematicModel). No ROS here: the file is found next to this package, or given.
+"""Joint limits, gripper limits, link lengths and the wrist camera's offset read from the URDF
+(rascal_description/urdf/wx250s.urdf), so no Python module writes them down again. The C++ side
+reads the same file (rascal_workcell::GripperGeometry, rascal_control::KinematicModel). No ROS here: the file is found next to this package, or given.
 """
 import functools
 import math
@@ -78,3 +78,9 @@ def opening_limits(urdf_xml: Optional[str] = None) -> Tuple[float, float]:
     """(closed, fully open) distance between the fingers, metres (facts §1.4: 30 .. 74 mm)."""
     lo, hi = finger_limits(urdf_xml)
     return 2.0 * lo, 2.0 * hi
+
+
+def camera_offset(urdf_xml: Optional[str] = None) -> float:
+    """How far the wrist camera sits from the gripper's axis, metres: with the gripper pointing
+    down it is that far out along the gripper's yaw direction (camera_mount's z)."""
+    return _origin("camera_mount", urdf_xml)[2]

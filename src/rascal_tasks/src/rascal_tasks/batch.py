@@ -1,0 +1,158 @@
+"""What every state of a batch shares (`Batch`), and how a state turns failures into outcomes
+(`BatchState`, following the rule of `failures.py`). No ROS here: the rig, recorder and
+progress callback are injected.
+"""
+
+import contextlib
+import threading
+from typing import Callable, List, Optional
+
+from rascal_tasks.catalogue.errors import CatalogueError
+from rascal_tasks.failures import LOSE_SHERD, SherdFailure, classify
+from rascal_tasks.rig import Observation, Rig, RigError, Timings
+from rascal_tasks.sherd_record import SherdRecord
+from rascal_tasks.stations import STATION_PLUGINS
+
+try:  # a rig with real smach uses it; ours has the same names and semantics
+    import smach
+except ImportError:  # pragma: no cover - depends on the machine
+    from rascal_tasks import smach
+
+
+class Batch:
+    """Everything the states share: config, rig, recorder, and the sherd in hand."""
+
+    def __init__(
+        self,
+        config,
+        rig: Rig,
+        recorder,
+        context: str,
+        progress: Optional[Callable[[str], None]] = None,
+        log=None,
+    ):
+        self.config = config
+        self.rig = rig
+        self.recorder = recorder  # rascal_tasks.recorder.Recorder, bound to `context`
+        self.context = context
+        self.progress = progress or (lambda state: None)
+        self.log = log or (lambda msg: None)
+        self.sherd: Optional[SherdRecord] = None
+        # Time spent for the sherd in progress (or the next one: surveying counts for it).
+        self.timings = Timings()
+        self.state_times = {}  # state label -> seconds, for the summary and the benchmark
+        self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
+        self.misses = {}  # rounded (x, y) -> pickups that failed there
+        self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
+        self.pending: List[Observation] = []
+        self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
+        self.empty_surveys = 0
+        self.completed = 0  # changed only by SherdRecord._finish
+        self.lost = 0  # changed only by SherdRecord._finish
+        self.started = rig.clock.now()
+        self.station_names = config.station_order()
+        self.plugins = [
+            STATION_PLUGINS[config.stations[n].type](config.stations[n], self)
+            for n in self.station_names
+        ]
+        self.pickup = next(s for s in config.stations.values() if s.type == "pickup")
+
+    @contextlib.contextmanager
+    def phase(self, name: str):
+        t0 = self.rig.clock.now()
+        try:
+            yield
+        finally:
+            self.timings.add(name, self.rig.clock.now() - t0)
+
+    def event(self, sherd: Optional[SherdRecord], kind: str, detail: str = ""):
+        """Log what happened; a sherd's events also go into its catalogue notes."""
+        self.log("%s %s: %s" % ("sherd %d" % sherd.seq if sherd else "batch", kind, detail))
+        if sherd is not None:
+            sherd.note("%s: %s" % (kind, detail))
+
+    def check_stop(self):
+        if self.stop_requested.is_set():
+            raise RigError("batch", "PREEMPTED", "stop requested")
+
+    def move_down(self, x, y, z, yaw, linear=False):
+        self.check_stop()
+        with self.phase("locomotion"):
+            self.rig.arm.move_down(x, y, z, yaw, linear=linear)
+
+    def travel_z(self) -> float:
+        return self.config["arm"]["travel_z"]
+
+    def in_the_way(self, station) -> bool:
+        """Whether a sherd left lying on `station` lies where a later sherd is placed."""
+        return any(p.station is station and not p.release_from_above for p in self.plugins)
+
+    def per_sherd(self) -> float:
+        done = self.completed + self.lost
+        return (self.rig.clock.now() - self.started) / done if done else 0.0
+
+
+class BatchState(smach.State):
+    """A state with the batch at hand. Checks for preemption between rig calls, and turns what
+    goes wrong into an outcome: a failure of this sherd that `failures.classify` lets the batch
+    survive records the sherd lost and takes `next_sherd`; anything else aborts (the machine
+    parks the arm)."""
+
+    next_sherd: Optional[str] = None  # outcome after a sherd failure (None: it always stops)
+
+    def __init__(self, batch: Batch, outcomes):
+        smach.State.__init__(self, outcomes=list(outcomes) + ["preempted", "aborted"])
+        self.batch = batch
+
+    def execute(self, userdata):
+        b = self.batch
+        label = self.label()
+        b.progress(label)
+        if self.preempt_requested():
+            self.service_preempt()
+            return "preempted"
+        t0 = b.rig.clock.now()
+        try:
+            try:  # nested: a database error while recording a loss still parks the arm
+                return self.run()
+            except SherdFailure as f:
+                return self.after_sherd_failure(f)
+        except RigError as e:
+            if e.code == "PREEMPTED" or self.preempt_requested():
+                self.service_preempt()
+                return "preempted"
+            self.report("rig_error", str(e))
+            return "aborted"
+        except CatalogueError as e:
+            b.event(None, "database_error", str(e))  # not into the notes: the database failed
+            return "aborted"
+        finally:
+            b.state_times[label] = b.state_times.get(label, 0.0) + b.rig.clock.now() - t0
+
+    def after_sherd_failure(self, f: SherdFailure) -> str:
+        b = self.batch
+        if classify(f, left_in_the_way=b.in_the_way(f.station)) == LOSE_SHERD and self.next_sherd:
+            return self.sherd_failed(f)
+        self.report(
+            "stopped",
+            "%s; it lies on the %s, unfinished: a restart resumes it" % (f.reason, f.station.name),
+        )
+        return "aborted"
+
+    def sherd_failed(self, failure: SherdFailure) -> str:
+        """The sherd in hand is lost (it lies where it harms nothing); go on with the next."""
+        self.batch.sherd.lose(failure.reason)
+        return self.next_sherd
+
+    def report(self, kind: str, detail: str):
+        """An event against the sherd in hand, in the log alone if its notes cannot be written."""
+        try:
+            self.batch.event(self.batch.sherd, kind, detail)
+        except CatalogueError:
+            self.batch.event(None, kind, detail)
+
+    def label(self) -> str:
+        return type(self).__name__
+
+    def run(self) -> str:
+        raise NotImplementedError

@@ -1,0 +1,76 @@
+"""Grasping: how wide to open, and a grasp with its retries. Used by every state that picks a
+sherd up (pickup, repick, recovery, resume). No ROS in here.
+"""
+
+import contextlib
+
+from rascal_workcell import urdf_model
+
+from rascal_tasks.failures import SherdFailure, about_this_sherd
+from rascal_tasks.rig import Observation, RigError
+from rascal_tasks.survey import survey_at
+
+# Opening between the fingertips, from the URDF's finger limits (facts §1.4: 30..74 mm).
+MIN_OPENING, MAX_OPENING = urdf_model.opening_limits()
+
+
+def opening_for(width: float, margin: float) -> float:
+    return min(MAX_OPENING, max(MIN_OPENING, width + margin))
+
+
+@contextlib.contextmanager
+def _aiming_at(o: Observation, station):
+    """Moves to a target computed from the detection `o`: a refusal is the sherd's failure."""
+    try:
+        yield
+    except RigError as e:
+        if about_this_sherd(e, sherd_target=True):
+            raise SherdFailure(
+                "the arm refused its grasp at (%.3f, %.3f) m on the %s: %s"
+                % (o.grasp_x, o.grasp_y, station.name, e),
+                station,
+                o,
+            ) from e
+        raise
+
+
+def grasp(b, o: Observation, station) -> bool:
+    """Open to the planned width (it includes the grasp margin), descend, close, lift.
+    Raises SherdFailure when the arm refuses the approach or the descent (failures.py)."""
+    with b.phase("grasping"):
+        b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
+    approach = o.grasp_z + b.config["arm"]["approach_offset"]
+    with _aiming_at(o, station):
+        b.move_down(o.grasp_x, o.grasp_y, approach, o.grasp_yaw)
+        b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)
+    with b.phase("grasping"):
+        held = b.rig.gripper.close().holding
+    b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
+    if held and not b.rig.gripper.holding():
+        held = False  # slipped out while lifting
+    if not held:
+        with b.phase("grasping"):
+            b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
+    return held
+
+
+def grasp_retrying(b, o: Observation, station, like=None):
+    """Grasp `o` at `station`; after a miss, detect again around it and grasp the detection
+    nearest it (or least `like`), up to recovery.max_grasp_attempts in all.
+    Returns (the last observation tried, grasps made, whether it is held)."""
+    rec = b.config["recovery"]
+    like = like or (lambda c, last: c.distance_to(last.x, last.y))
+    for attempt in range(rec["max_grasp_attempts"]):
+        if grasp(b, o, station):
+            return o, attempt + 1, True
+        if attempt + 1 == rec["max_grasp_attempts"]:
+            break
+        near = [
+            c
+            for c in survey_at(b, station, o.x, o.y)
+            if c.distance_to(o.x, o.y) < rec["search_radius"]
+        ]
+        if not near:
+            break
+        o = min(near, key=lambda c, last=o: like(c, last))
+    return o, attempt + 1, False

@@ -1,0 +1,50 @@
+"""PICKUP: the next sherd of the survey is grasped from the pickup area and, once it is in the
+gripper, numbered. No ROS in here.
+"""
+
+from rascal_tasks.batch import BatchState
+from rascal_tasks.manipulation import grasp_retrying
+from rascal_tasks.sherd_record import SherdRecord
+
+
+class Pickup(BatchState):
+    """Pick the next sherd from the pickup area; number it once it is in the gripper."""
+
+    next_sherd = "missed"
+
+    def __init__(self, batch):
+        super().__init__(batch, ["held", "missed"])
+
+    def run(self):
+        b = self.batch
+        o, tries, held = grasp_retrying(b, b.pending.pop(0), b.pickup)
+        if held:
+            b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
+            return "held"
+        attempts = b.config["recovery"]["max_grasp_attempts"]
+        b.pending = []  # the area changed under us: survey again
+        key = (round(o.x, 2), round(o.y, 2))
+        b.misses[key] = b.misses.get(key, 0) + 1
+        if b.misses[key] >= 2:
+            b.unpickable.append((o.x, o.y))
+            b.event(
+                None,
+                "unpickable",
+                "sherd at (%.3f, %.3f) m left in the pickup area after "
+                "%d failed grasps" % (o.x, o.y, 2 * attempts),
+            )
+        return "missed"
+
+    def sherd_failed(self, failure):
+        """Its grasp was refused: it has no number (it never left the mat), and another try
+        would be refused too, so it is left for a person at once."""
+        b = self.batch
+        o = failure.observation
+        b.pending = []
+        b.unpickable.append((o.x, o.y))
+        b.event(
+            None,
+            "unpickable",
+            "sherd at (%.3f, %.3f) m left in the pickup area: %s" % (o.x, o.y, failure.reason),
+        )
+        return "missed"

@@ -1,0 +1,93 @@
+"""RECOVER_i: a sherd dropped on its way, looked for and picked up again, or recorded lost.
+No ROS in here.
+"""
+
+from rascal_tasks.batch import BatchState
+from rascal_tasks.manipulation import grasp_retrying
+from rascal_tasks.sherd_record import SherdRecord
+from rascal_tasks.survey import survey_at, survey_pickup_area
+
+
+class Recover(BatchState):
+    """A dropped sherd: look where it was last seen; then, if it was on its way from the pickup
+    area, where it was picked up and over the whole pickup area (a grasp that slips while lifting
+    drops it back there), or, if it was already measured, at the station it was carried to (it
+    was never above the pickup area again, and a sherd from there would put another sherd's
+    mass or photo in its row). Of what is found, the one most like it (position, then size) is
+    taken, so another sherd lying near is not; what lies off a station is left for a person."""
+
+    next_sherd = "lost"
+
+    def __init__(self, batch):
+        super().__init__(batch, ["held", "lost"])
+
+    def run(self):
+        b = self.batch
+        s = b.sherd
+        if s.drops > b.config["recovery"]["max_searches"]:
+            return self.lose("dropped %d times" % s.drops)
+        station, candidates, ref = self.search(s)
+        like = s.observation
+        if not candidates:
+            return self.lose(
+                "not found where it was last seen (%s)%s"
+                % (s.where, ", nor in the pickup area" if s.station_index < 0 else "")
+            )
+
+        def unlikeness(c):
+            # A drop scatters a sherd by centimetres; its size is measured within ~3 mm, so a
+            # size difference weighs four times a distance.
+            return c.distance_to(*ref) + 4 * (
+                abs(c.length - like.length) + abs(c.width - like.width)
+            )
+
+        o, tries, held = grasp_retrying(
+            b, min(candidates, key=unlikeness), station, like=lambda c, _last: unlikeness(c)
+        )
+        if not held:
+            return self.lose("found but could not be picked up (%d grasps)" % tries)
+        b.event(
+            s, "recovered", "picked up again at the %s, (%.3f, %.3f) m" % (station.name, o.x, o.y)
+        )
+        s.grasped_as(o, station)
+        if station is b.pickup and s.station_index < 0:
+            # Picked afresh from the pickup area: what is in the gripper now is what gets measured.
+            s.seen(o, b.pickup)
+            s.record_dimensions(o)
+        return "held"
+
+    def lose(self, reason: str) -> str:
+        self.batch.sherd.lose(reason)
+        return "lost"
+
+    def search(self, s: SherdRecord):
+        """(station, detections, reference point) of the first place that shows something."""
+        b = self.batch
+        where = b.config.stations.get(s.where, b.pickup)
+        places = [(where, s.last_xy)]
+        if s.station_index >= 0:
+            # Lifted from a station after it was measured: it was never above the pickup area
+            # again. It fell where it was lifted, or where it was carried to.
+            nxt = s.station_index + 1
+            if nxt < len(b.plugins) and b.plugins[nxt].station is not where:
+                places.append((b.plugins[nxt].station, b.plugins[nxt].station.place_at))
+        elif s.picked_xy is not None and (where is not b.pickup or s.picked_xy != s.last_xy):
+            places.append((b.pickup, s.picked_xy))
+        for station, xy in places:
+            seen = survey_at(b, station, *xy)
+            # What the wrist camera sees beyond the station (the table around the scale) lies
+            # at another height than the station's surface the grasp is planned from.
+            on = [o for o in seen if station.area.has((o.x, o.y))]
+            for o in seen:
+                if o not in on:
+                    b.event(
+                        s,
+                        "seen_off_station",
+                        "a sherd at (%.3f, %.3f) m, off the %s: "
+                        "left for a person" % (o.x, o.y, station.name),
+                    )
+            if on:
+                return station, on, xy
+        if s.station_index >= 0:
+            return where, [], s.last_xy
+        return b.pickup, survey_pickup_area(b), s.picked_xy or s.last_xy

@@ -1,0 +1,144 @@
+"""The start of a batch, and a restart after a killed run: HOME (a sherd left in the fingers is
+set down), CALIBRATE (background models, kept where a sherd lies), RESUME (the unfinished sherd
+found and carried on with). No ROS in here.
+"""
+
+from rascal_tasks.batch import BatchState
+from rascal_tasks.manipulation import grasp
+from rascal_tasks.rig import Timings
+from rascal_tasks.sherd_record import SherdRecord
+from rascal_tasks.survey import camera_over, survey_at
+
+# ee_gripper_link height above the pickup mat where Home lets go of a sherd found in the fingers
+# after a restart: fingertips 4.4 mm lower, so a sherd up to ~2 cm thick drops a few mm at most.
+PUT_BACK_HEIGHT = 0.025
+
+
+class Home(BatchState):
+    """Open the gripper over the pickup area.
+
+    After a killed run the fingers may still hold its unfinished sherd (or be open around it):
+    a close tells. That sherd is set down where it was picked up, which is free, and Resume
+    picks it up again; the stations must be calibrated with nothing in the wrist camera's view."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["done"])
+
+    def run(self):
+        b = self.batch
+        rows = b.recorder.unfinished()
+        if rows:
+            with b.phase("grasping"):
+                in_hand = b.rig.gripper.close().holding
+            if in_hand:
+                seq, _status, (x, y) = rows[0]
+                b.move_down(x, y, b.travel_z(), 0.0)
+                # a short drop: after a restart the grasp height is not known
+                b.move_down(x, y, b.pickup.surface_z + PUT_BACK_HEIGHT, 0.0, linear=True)
+                with b.phase("grasping"):
+                    b.rig.gripper.open()
+                b.move_down(x, y, b.travel_z(), 0.0, linear=True)
+                b.put_back = (seq, x, y)
+                b.event(
+                    None,
+                    "put_back",
+                    "sherd %d was in the gripper; set down at its pickup "
+                    "spot (%.3f, %.3f) m" % (seq, x, y),
+                )
+        with b.phase("grasping"):
+            b.rig.gripper.open()
+        b.move_down(*b.pickup.area.center, b.travel_z(), 0.0)
+        return "done"
+
+
+class Calibrate(BatchState):
+    """Learn each station's background from an image of it. The pickup area is full of sherds,
+    so its background (the same mat) is learnt where the discard box's mat shows.
+
+    A station where the scale or the camera already sees a sherd keeps the model it had: that
+    is a killed run's sherd (or one left by hand), and learning it as background would hide it."""
+
+    def __init__(self, batch):
+        super().__init__(batch, ["done"])
+
+    def run(self):
+        b = self.batch
+        for plugin in b.plugins:
+            st = plugin.station
+            camera_over(b, st, *st.place_at)
+            if not plugin.release_from_above:
+                seen = b.rig.perception.detect_if_calibrated(st.name)
+                if seen:
+                    b.event(
+                        None,
+                        "calibration_kept",
+                        "%d sherd(s) lying at the %s: its "
+                        "background model from before is kept" % (len(seen), st.name),
+                    )
+                    continue
+            b.rig.perception.calibrate(st.name)
+            if st.type == "discard":
+                b.rig.perception.calibrate(b.pickup.name)
+        b.timings = Timings()  # set-up is the batch's, not the first sherd's
+        return "done"
+
+
+class Resume(BatchState):
+    """After a restart: find the sherd a killed run left unfinished and carry on with it.
+
+    Outcomes name the state to go on with: TRANSLATE_k (it was in the gripper; Home set it
+    down at its pickup spot and it is picked up again),
+    STATION_i (it lies placed at station i, not yet measured there), REPICK_i (it lies at
+    station i, measured), or SURVEY (nothing unfinished, or it is lost)."""
+
+    next_sherd = "SURVEY"
+
+    def __init__(self, batch):
+        n = len(batch.plugins)
+        super().__init__(
+            batch,
+            ["SURVEY"]
+            + ["%s_%d" % (k, i) for i in range(n) for k in ("TRANSLATE", "STATION")]
+            + ["REPICK_%d" % i for i in range(n - 1)],
+        )
+
+    def run(self):
+        b = self.batch
+        rows = b.recorder.unfinished()
+        if not rows:
+            return "SURVEY"
+        seq, status, _pickup_xy = rows[0]
+        statuses = [p.status for p in b.plugins]
+        done = statuses.index(status) if status in statuses else -1
+        b.event(None, "resume", "sherd %d was %s" % (seq, status))
+        s = b.sherd = SherdRecord.resumed(b, seq, status)
+        if b.put_back and b.put_back[0] == seq:
+            return self.pick_put_back(s, done)
+        for i in range(max(done, 0), len(b.plugins)):
+            st = b.plugins[i].station
+            if b.plugins[i].release_from_above:
+                break
+            seen = survey_at(b, st, *st.place_at)
+            if seen:
+                s.seen(seen[0], st)
+                s.station_done(done)
+                return ("REPICK_%d" if i == done else "STATION_%d") % i
+        s.lose("not found after restart (was %s)" % status)
+        return "SURVEY"
+
+    def pick_put_back(self, s: SherdRecord, done: int) -> str:
+        b = self.batch
+        _, x, y = b.put_back
+        near = [
+            o
+            for o in survey_at(b, b.pickup, x, y)
+            if o.distance_to(x, y) < b.config["recovery"]["search_radius"]
+        ]
+        for o in sorted(near, key=lambda o: o.distance_to(x, y))[:1]:
+            if grasp(b, o, b.pickup):
+                s.seen(o, b.pickup)
+                s.picked_xy = (o.x, o.y)
+                s.station_done(done)
+                return "TRANSLATE_%d" % (done + 1)
+        s.lose("set down at its pickup spot after restart, not picked up again")
+        return "SURVEY"

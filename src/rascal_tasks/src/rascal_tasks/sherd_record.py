@@ -1,0 +1,123 @@
+"""One sherd's record: what the batch knows of the sherd in progress, and every catalogue write
+for it.
+
+A sherd is numbered once it is in the gripper (`SherdRecord.picked`), or taken over from a killed
+run (`SherdRecord.resumed`). Its status then moves picked -> weighed -> photographed -> done, or
+to lost. `done` and `lost` both end in `_finish`, the one place that counts completed and lost
+sherds. No ROS here.
+"""
+
+from typing import Optional, Tuple
+
+from rascal_tasks.rig import Observation, Timings
+
+FINAL = ("done", "lost")
+
+
+class SherdRecord:
+    def __init__(self, batch, seq: int, status: str = "picked"):
+        self.batch = batch  # rascal_tasks.batch.Batch: its recorder, log and counts
+        self.seq = seq
+        self.status = status  # catalogue status, as far as this run knows
+        self.observation: Optional[Observation] = None  # its detection (for its likeness)
+        self.grasp_yaw = 0.0
+        self.grasp_height = 0.0  # ee height above the surface when closing
+        self.width = 0.0  # across the fingers (m)
+        self.station_index = -1  # last station done (-1: none yet)
+        self.where = "pickup"  # station it was last seen at
+        self.last_xy: Tuple[float, float] = (0.0, 0.0)
+        self.picked_xy: Optional[tuple] = None  # where it was picked (None: unknown on resume)
+        self.drops = 0
+        self.mass: Optional[float] = None
+        # The batch's timings since the last sherd ended: surveying counts for this one.
+        self.timings: Timings = batch.timings
+
+    @classmethod
+    def picked(cls, batch, o: Observation, station, attempts: int) -> "SherdRecord":
+        """Number a sherd now in the gripper, picked as `o` from `station`."""
+        rec = cls(batch, batch.recorder.new_sherd((o.x, o.y), attempts=attempts))
+        rec.seen(o, station)
+        rec.picked_xy = (o.x, o.y)
+        rec.record_dimensions(o)
+        return rec
+
+    @classmethod
+    def resumed(cls, batch, seq: int, status: str) -> "SherdRecord":
+        """A sherd a killed run left unfinished; where it is, is not known yet."""
+        return cls(batch, seq, status)
+
+    @property
+    def finished(self) -> bool:
+        return self.status in FINAL
+
+    # -- what is known of it ---------------------------------------------------------------------
+    def seen(self, o: Observation, station):
+        """Detected as `o` lying on `station`."""
+        self.observation, self.where, self.last_xy = o, station.name, (o.x, o.y)
+        self.grasped_as(o, station)
+
+    def grasped_as(self, o: Observation, station):
+        """The next grasp follows the detection `o` on `station`."""
+        self.grasp_yaw, self.width = o.grasp_yaw, o.width
+        self.grasp_height = o.grasp_z - station.surface_z
+
+    def placed(self, station):
+        self.where, self.last_xy = station.name, tuple(station.place_at)
+
+    def station_done(self, index: int):
+        self.station_index = index
+
+    # -- catalogue writes (each commits) ---------------------------------------------------------
+    def record_dimensions(self, o: Observation):
+        self.batch.recorder.dimensions(self.seq, o.length, o.width, o.height)
+
+    def record_mass(self, kg: float, stable: bool):
+        self.batch.recorder.mass(self.seq, kg, stable)
+        self.mass, self.status = kg, "weighed"
+
+    def spool_path(self) -> str:
+        return self.batch.recorder.spool_path(self.seq)
+
+    def record_photo(self, path: str) -> str:
+        archived = self.batch.recorder.photo(self.seq, path)
+        self.status = "photographed"
+        return archived
+
+    def dropped(self, where: str):
+        self.drops += 1
+        self.batch.event(self, "dropped", where)
+        self.batch.recorder.drop(self.seq, where)
+
+    def note(self, text: str):
+        self.batch.recorder.note(self.seq, text)
+
+    def done(self):
+        self._must_be_open("done")
+        self.batch.recorder.done(self.seq, timings=self.timings.as_dict())
+        self._finish("done")
+
+    def lose(self, reason: str):
+        """The one way a sherd is recorded lost."""
+        self._must_be_open("lost")
+        self.batch.event(self, "lost", reason)
+        self.batch.recorder.lost(self.seq, reason, timings=self.timings.as_dict())
+        self._finish("lost")
+
+    def _must_be_open(self, status: str):
+        if self.finished:
+            raise RuntimeError(
+                "SherdRecord.%s: sherd %d is %s already"
+                % ("done" if status == "done" else "lose", self.seq, self.status)
+            )
+
+    def _finish(self, status: str):
+        """Counts the sherd: the only place `completed` and `lost` change."""
+        self.status = status
+        b = self.batch
+        if status == "done":
+            b.completed += 1
+        else:
+            b.lost += 1
+        if b.sherd is self:
+            b.sherd = None
+        b.timings = Timings()  # the next sherd's time starts now

@@ -1,0 +1,272 @@
+"""An in-memory rig and recorder for master-free runs of the whole batch machine (imported by
+name; not a conftest).
+
+`World` holds sherds lying on the stations of the config. The arm moves at once (1 s of the
+fake clock per move) unless `refuse(x, y, z, yaw, linear)` returns a RigError code; the gripper
+holds the sherd under the fingertips when it closes low enough and sets it down (or drops it)
+where it opens; the wrist camera sees the sherds of a station within 0.15 m of it; the scale
+weighs what lies on it. `Recorder` keeps the catalogue's status rules in memory.
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional
+
+from rascal_tasks import rig
+from rascal_tasks.catalogue.errors import StatusError
+from rascal_tasks.survey import CAMERA_OFFSET
+
+VIEW_RADIUS = 0.15  # m around the wrist camera's axis
+GRASP_ABOVE = 0.005  # grasp_z above the station surface that perception plans
+
+
+@dataclass
+class Sherd:
+    name: str
+    x: float
+    y: float
+    length: float = 0.05
+    width: float = 0.04
+    height: float = 0.01
+    mass: float = 0.020  # kg
+    station: Optional[str] = "pickup"  # None: on the table, off every station
+
+
+class World:
+    def __init__(self, config, sherds: List[Sherd]):
+        self.config = config
+        self.sherds = list(sherds)
+        self.held: Optional[Sherd] = None
+        self.grasped_at = (0.0, 0.0)
+        self.at = (0.0, 0.0, 0.3, 0.0)  # ee_gripper_link x, y, z, yaw
+        self.t = 0.0
+        self.moves: List[tuple] = []
+        self.named: List[str] = []  # named poses gone to (park: "sleep")
+        self.refuse = lambda x, y, z, yaw, linear: None
+        self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
+        self.camera_refusals = 0  # captures to refuse before one succeeds
+        self.tare = 0.0
+
+    def station_at(self, x, y):
+        for st in self.config.stations.values():
+            if st.area.has((x, y)):
+                return st
+        return None
+
+    def lying(self, station: str) -> List[Sherd]:
+        return [s for s in self.sherds if s is not self.held and s.station == station]
+
+    def put(self, s: Sherd, x, y):
+        st = self.station_at(x, y)
+        s.x, s.y, s.station = x, y, st.name if st else None
+
+    def rig(self) -> rig.Rig:
+        return rig.Rig(
+            _Arm(self), _Gripper(self), _Perception(self), _Scale(self), _Camera(self), _Clock(self)
+        )
+
+
+class _Arm(rig.Arm):
+    def __init__(self, world):
+        self.w = world
+
+    def move_down(self, x, y, z, yaw, linear=False):
+        code = self.w.refuse(x, y, z, yaw, linear)
+        if code:
+            raise rig.RigError("arm", code, "goal (%.3f, %.3f, %.3f)" % (x, y, z))
+        self.w.at = (x, y, z, yaw)
+        self.w.moves.append((x, y, z, yaw, linear))
+        self.w.t += 1.0
+        return 1.0
+
+    def go(self, named):
+        self.w.named.append(named)
+        self.w.t += 1.0
+        return 1.0
+
+    def stop(self):
+        pass
+
+
+class _Gripper(rig.Gripper):
+    def __init__(self, world):
+        self.w = world
+
+    def open(self, width=None):
+        if self.w.held is not None:
+            s, self.w.held = self.w.held, None
+            self.w.put(s, *self.w.at[:2])
+        return 0.5
+
+    def close(self):
+        x, y, z, _ = self.w.at
+        st = self.w.station_at(x, y)
+        for s in self.w.lying(st.name if st else None):
+            if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.height:
+                self.w.held, self.w.grasped_at = s, (x, y)
+                return rig.GraspResult(True, s.width)
+        return rig.GraspResult(False, 0.030)
+
+    def holding(self):
+        s = self.w.held
+        x, y = self.w.at[:2]
+        if (
+            s is not None
+            and s.name in self.w.slips
+            and math.hypot(x - self.w.grasped_at[0], y - self.w.grasped_at[1]) > 0.05
+        ):
+            self.w.held = None  # slipped out on the way
+            self.w.put(s, *self.w.slips.pop(s.name))
+        return self.w.held is not None
+
+    def width(self):
+        return self.w.held.width if self.w.held else 0.030
+
+
+class _Perception(rig.Perception):
+    def __init__(self, world):
+        self.w = world
+        self.calibrated: List[str] = []
+
+    def calibrate(self, station):
+        self.calibrated.append(station)
+
+    def detect(self, station):
+        x, y, _, yaw = self.w.at
+        cx, cy = x + CAMERA_OFFSET * math.cos(yaw), y + CAMERA_OFFSET * math.sin(yaw)
+        surface = self.w.config.stations[station].surface_z
+        return [
+            rig.Observation(
+                s.x,
+                s.y,
+                0.0,
+                s.length,
+                s.width,
+                s.height,
+                s.x,
+                s.y,
+                surface + GRASP_ABOVE,
+                0.0,
+                s.width + 0.012,
+            )
+            for s in self.w.lying(station)
+            if math.hypot(s.x - cx, s.y - cy) < VIEW_RADIUS
+        ]
+
+    def detect_if_calibrated(self, station):
+        return self.detect(station) if station in self.calibrated else None
+
+
+class _Scale(rig.Scale):
+    def __init__(self, world):
+        self.w = world
+
+    def _load(self):
+        return sum(s.mass for s in self.w.lying("scale"))
+
+    def tare(self):
+        self.w.tare = self._load()
+
+    def read_stable(self, timeout):
+        self.w.t += 1.0
+        return rig.ScaleReading(self._load() - self.w.tare, True)
+
+
+class _Camera(rig.ArchivalCamera):
+    def __init__(self, world):
+        self.w = world
+
+    def capture(self, path):
+        if self.w.camera_refusals > 0:
+            self.w.camera_refusals -= 1
+            raise rig.RigError("/archival_camera/capture", "REFUSED", "cannot write " + path)
+        return rig.Capture(path, self.w.t, 2000, 1500)
+
+
+class _Clock(rig.Clock):
+    def __init__(self, world):
+        self.w = world
+
+    def now(self):
+        return self.w.t
+
+    def sleep(self, seconds):
+        self.w.t += seconds
+
+
+@dataclass
+class Row:
+    seq: int
+    status: str = "picked"
+    pickup_xy: tuple = (0.0, 0.0)
+    mass: Optional[float] = None
+    image: Optional[str] = None
+    lost_reason: Optional[str] = None
+    drops: int = 0
+    notes: List[str] = field(default_factory=list)
+
+
+class Recorder:
+    """The catalogue's rows and status rules, in memory; `writes` lists every call in order."""
+
+    AFTER = {
+        "weighed": ("picked", "weighed"),
+        "photographed": ("weighed", "photographed"),
+        "done": ("photographed",),
+        "lost": ("picked", "weighed", "photographed"),
+    }
+
+    def __init__(self, unfinished=()):
+        self.sherds: Dict[int, Row] = {}
+        self._unfinished = list(unfinished)
+        for seq, status, xy in self._unfinished:
+            self.sherds[seq] = Row(seq, status, xy)
+        self.writes: List[tuple] = []
+
+    def _move(self, seq, status):
+        row = self.sherds[seq]
+        if row.status not in self.AFTER[status]:
+            raise StatusError("sherd %d is %r: cannot record %r" % (seq, row.status, status))
+        row.status = status
+        self.writes.append((status, seq))
+        return row
+
+    def new_sherd(self, pickup_xy, attempts=1):
+        seq = max(self.sherds, default=0) + 1
+        self.sherds[seq] = Row(seq, pickup_xy=tuple(pickup_xy))
+        self.writes.append(("picked", seq))
+        return seq
+
+    def dimensions(self, seq, length, width, thickness):
+        self.writes.append(("dimensions", seq))
+
+    def mass(self, seq, kg, stable, seconds=None):
+        self._move(seq, "weighed").mass = kg
+
+    def spool_path(self, seq):
+        return "/spool/T-%d.png" % seq
+
+    def photo(self, seq, image_path, seconds=None):
+        self._move(seq, "photographed").image = image_path
+        return image_path
+
+    def done(self, seq, seconds=None, timings=None):
+        self._move(seq, "done")
+
+    def lost(self, seq, reason, timings=None):
+        self._move(seq, "lost").lost_reason = reason
+
+    def drop(self, seq, station):
+        self.sherds[seq].drops += 1
+
+    def grasp_attempt(self, seq, station):
+        pass
+
+    def note(self, seq, text):
+        self.sherds[seq].notes.append(text)
+
+    def unfinished(self):
+        return self._unfinished
+
+    def status(self) -> Dict[int, str]:
+        return {seq: row.status for seq, row in sorted(self.sherds.items())}

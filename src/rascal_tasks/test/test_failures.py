@@ -1,0 +1,191 @@
+"""Core tests of the failure rule (`failures.classify`) and of whole batches that meet failures,
+run against the in-memory rig of `fake_rig.py` (no master, no database)."""
+
+import math
+import os
+
+import pytest
+import yaml
+from fake_rig import Recorder, Sherd, World
+
+from rascal_tasks import workflow
+from rascal_tasks.catalogue.errors import CatalogueError
+from rascal_tasks.config import config_from_dict
+from rascal_tasks.failures import LOSE_SHERD, STOP, SherdFailure, classify
+from rascal_tasks.rig import RigError
+from rascal_tasks.stations import DiscardStation
+
+WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+
+
+@pytest.fixture
+def config():
+    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
+        return config_from_dict(yaml.safe_load(f))
+
+
+# -- the rule ----------------------------------------------------------------------------------
+@pytest.mark.parametrize("code", ["UNREACHABLE", "NO_IK", "COLLISION", "INVALID_GOAL"])
+def test_an_arm_refusing_a_grasp_target_loses_only_the_sherd(code):
+    assert classify(RigError("arm", code, "x"), sherd_target=True) == LOSE_SHERD
+
+
+@pytest.mark.parametrize("code", ["TIMEOUT", "PREEMPTED", "MISSING", "FAILED", "SOMETHING_NEW"])
+def test_an_arm_that_times_out_or_is_gone_stops_even_on_a_grasp_target(code):
+    assert classify(RigError("arm", code, "x"), sherd_target=True) == STOP
+
+
+def test_a_refusal_of_any_other_move_stops():
+    # travel, placing, lifting: moves made with the sherd in the fingers, or the rig's own
+    assert classify(RigError("arm", "UNREACHABLE", "x"), sherd_target=False) == STOP
+
+
+@pytest.mark.parametrize(
+    "error",
+    [
+        RigError("perception", "DETECT", "x"),
+        RigError("/scale/mass", "TIMEOUT", "x"),
+        RigError("/archival_camera/capture", "REFUSED", "x"),
+        CatalogueError("database down"),
+        ValueError("a bug"),
+    ],
+)
+def test_device_database_and_other_errors_stop(error):
+    assert classify(error, sherd_target=True) == STOP
+
+
+def test_a_sherd_failure_stops_where_the_sherd_is_in_the_way(config):
+    f = SherdFailure("the scale station failed for it", config.stations["scale"])
+    assert classify(f) == LOSE_SHERD
+    assert classify(f, left_in_the_way=True) == STOP
+    assert classify(RigError("arm", "UNREACHABLE", "x"), True, left_in_the_way=True) == STOP
+
+
+# -- whole batches -------------------------------------------------------------------------------
+def _run(config, world, recorder=None):
+    recorder = recorder or Recorder()
+    batch = workflow.Batch(config, world.rig(), recorder, context="T", log=print)
+    outcome = workflow.build_machine(batch).execute()
+    return outcome, batch, recorder
+
+
+def _near(x, y, radius=0.005, below=None, code="UNREACHABLE"):
+    """A refusal of every move within `radius` of (x, y) (and lower than `below`, if given)."""
+
+    def refuse(mx, my, mz, yaw, linear):
+        if math.hypot(mx - x, my - y) < radius and (below is None or mz < below):
+            return code
+        return None
+
+    return refuse
+
+
+def test_two_sherds_end_in_done(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, mass=0.031)])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert [rec.sherds[1].mass, rec.sherds[2].mass] == pytest.approx([0.020, 0.031])
+    assert (batch.completed, batch.lost) == (2, 0)
+    assert [s.station for s in world.sherds] == ["discard", "discard"]
+    assert world.named == ["sleep"]
+
+
+def test_an_unreachable_sherd_is_lost_and_the_next_one_is_recorded(config):
+    # a slips on its way to the scale and falls back into the pickup area, where the arm cannot
+    # reach down to it
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.slips["a"] = (0.13, 0.22)
+    world.refuse = _near(0.13, 0.22, below=config["arm"]["travel_z"])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "lost", 2: "done"}
+    assert "arm: UNREACHABLE" in rec.sherds[1].lost_reason
+    assert "pickup" in rec.sherds[1].lost_reason
+    assert (batch.completed, batch.lost) == (1, 1)
+    assert world.named == ["sleep"]
+    # the lost sherd lies where it fell, left for a person, not numbered again
+    assert (world.sherds[0].x, world.sherds[0].y, world.sherds[0].station) == (0.13, 0.22, "pickup")
+    assert batch.unpickable == [(0.13, 0.22)]
+
+
+def test_an_unreachable_sherd_in_the_pickup_area_is_left_unnumbered(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.refuse = _near(0.10, 0.22, below=config["arm"]["travel_z"])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done"}  # b: a never had a number
+    assert rec.sherds[1].pickup_xy == (0.25, 0.30)
+    assert batch.unpickable == [(0.10, 0.22)]
+
+
+def test_an_arm_timeout_parks_and_stops_with_nothing_else_recorded(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    scale = config.stations["scale"]
+    world.refuse = _near(*scale.place_at, code="TIMEOUT")  # on the way to the scale
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "aborted"
+    assert world.named == ["sleep"]
+    assert rec.status() == {1: "picked"}  # unfinished: a restart resumes it
+    assert [w for w in rec.writes if w[0] in ("lost", "done")] == []
+    assert (batch.completed, batch.lost) == (0, 0)
+    assert any("rig_error: arm: TIMEOUT" in n for n in rec.sherds[1].notes)
+
+
+def test_a_timeout_on_a_grasp_target_stops_too(config):
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    world.refuse = _near(0.10, 0.22, below=config["arm"]["travel_z"], code="TIMEOUT")
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "aborted" and world.named == ["sleep"]
+    assert rec.status() == {} and batch.unpickable == []
+
+
+def test_a_sherd_that_cannot_be_picked_up_from_the_scale_stops_the_batch(config):
+    # It lies on the scale, where the next sherd would be placed: stop, unfinished, not lost.
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    scale = config.stations["scale"]
+    # the grasp descent (not the placing, 5 mm higher) is refused
+    world.refuse = _near(*scale.place_at, below=scale.surface_z + 0.0075)
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "aborted" and world.named == ["sleep"]
+    assert rec.status() == {1: "weighed"}
+    assert world.sherds[0].station == "scale"
+    assert any(
+        n.startswith("stopped: the arm refused its grasp") and "on the scale" in n
+        for n in rec.sherds[1].notes
+    )
+    assert (batch.completed, batch.lost) == (0, 0)
+
+
+def test_a_camera_that_refuses_stops_the_batch_with_the_sherd_unfinished(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.camera_refusals = 3
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "aborted" and world.named == ["sleep"]
+    assert rec.status() == {1: "weighed"}
+    assert world.sherds[0].station == "camera"
+
+
+def test_a_station_that_fails_where_nothing_is_placed_loses_the_sherd_only(config, monkeypatch):
+    # A station plug-in saying 'failed' for sherd 1 in the discard box: nothing is placed on it.
+    def after_place(self, sherd):
+        return "failed" if sherd.seq == 1 else "done"
+
+    monkeypatch.setattr(DiscardStation, "after_place", after_place)
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "lost", 2: "done"}
+    assert rec.sherds[1].lost_reason == "the discard station failed for it"
+    assert (batch.completed, batch.lost) == (1, 1)
+
+
+def test_a_database_error_parks_and_stops(config):
+    class Failing(Recorder):
+        def mass(self, seq, kg, stable, seconds=None):
+            raise CatalogueError("connection lost")
+
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    outcome, batch, rec = _run(config, world, Failing())
+    assert outcome == "aborted" and world.named == ["sleep"]
+    assert rec.status() == {1: "picked"}

@@ -1,0 +1,90 @@
+"""Core tests of SherdRecord: a sherd's catalogue writes and the one path that ends it (done or
+lost), which is where completed and lost sherds are counted (no master, no database)."""
+
+import os
+
+import pytest
+import yaml
+from fake_rig import Recorder, Sherd, World
+
+from rascal_tasks import workflow
+from rascal_tasks.config import config_from_dict
+from rascal_tasks.rig import Observation
+from rascal_tasks.sherd_record import SherdRecord
+
+WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+
+
+@pytest.fixture
+def config():
+    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
+        return config_from_dict(yaml.safe_load(f))
+
+
+def _batch(config, recorder=None, sherds=()):
+    world = World(config, list(sherds))
+    return workflow.Batch(config, world.rig(), recorder or Recorder(), context="T"), world
+
+
+def _obs(x, y):
+    return Observation(x, y, 0.0, 0.05, 0.04, 0.01, x, y, 0.005, 0.3, 0.052)
+
+
+def test_a_picked_sherd_is_numbered_with_its_dimensions_and_grasp(config):
+    b, _ = _batch(config)
+    s = SherdRecord.picked(b, _obs(0.1, 0.2), b.pickup, attempts=2)
+    assert s.seq == 1 and s.status == "picked"
+    assert b.recorder.writes == [("picked", 1), ("dimensions", 1)]
+    assert (s.where, s.last_xy, s.picked_xy) == ("pickup", (0.1, 0.2), (0.1, 0.2))
+    assert (s.grasp_yaw, s.grasp_height, s.width) == (0.3, 0.005, 0.04)
+
+
+def test_losing_a_sherd_records_notes_and_counts_it_once(config):
+    b, _ = _batch(config)
+    s = b.sherd = SherdRecord.picked(b, _obs(0.1, 0.2), b.pickup, attempts=1)
+    b.timings.add("grasping", 2.5)
+    timings = b.timings
+    s.lose("fell off the table")
+    row = b.recorder.sherds[1]
+    assert (row.status, row.lost_reason) == ("lost", "fell off the table")
+    assert row.notes == ["lost: fell off the table"]
+    assert (b.completed, b.lost) == (0, 1)
+    assert b.sherd is None and b.timings is not timings  # the next sherd's time starts afresh
+    with pytest.raises(RuntimeError, match="sherd 1 is lost already"):
+        s.lose("again")
+    with pytest.raises(RuntimeError, match="sherd 1 is lost already"):
+        s.done()
+    assert b.lost == 1 and [w for w in b.recorder.writes if w[0] == "lost"] == [("lost", 1)]
+
+
+def test_a_done_sherd_is_counted_completed(config):
+    b, _ = _batch(config)
+    s = b.sherd = SherdRecord.picked(b, _obs(0.1, 0.2), b.pickup, attempts=1)
+    s.record_mass(0.025, stable=True)
+    s.record_photo("/spool/T-1.png")
+    s.done()
+    assert b.recorder.status() == {1: "done"} and s.status == "done" and s.mass == 0.025
+    assert (b.completed, b.lost) == (1, 0) and b.sherd is None
+
+
+def test_a_sherd_not_found_after_a_restart_is_lost_through_the_same_path(config):
+    # sherd 2 was weighed when the run was killed; nothing lies anywhere now
+    rec = Recorder(unfinished=[(2, "weighed", (0.15, 0.22))])
+    b, world = _batch(config, rec)
+    outcome = workflow.build_machine(b).execute()
+    assert outcome == "finished" and world.named == ["sleep"]
+    assert rec.sherds[2].lost_reason == "not found after restart (was weighed)"
+    assert rec.sherds[2].notes == ["lost: not found after restart (was weighed)"]
+    assert (b.completed, b.lost) == (0, 1)
+
+
+def test_a_restart_carries_on_and_numbers_the_next_sherd_after_it(config):
+    # sherd 2 lies weighed on the scale; a new sherd lies in the pickup area
+    rec = Recorder(unfinished=[(2, "weighed", (0.15, 0.22))])
+    scale = config.stations["scale"]
+    b, world = _batch(
+        config, rec, [Sherd("old", *scale.place_at, station="scale"), Sherd("new", 0.10, 0.22)]
+    )
+    assert workflow.build_machine(b).execute() == "finished"
+    assert rec.status() == {2: "done", 3: "done"}
+    assert (b.completed, b.lost) == (2, 0)
