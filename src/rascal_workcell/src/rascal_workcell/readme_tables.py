@@ -7,6 +7,7 @@ and `update()` writes between them one row per key the schema lists for that rea
 name (type, unit, default, range) and its description. Tests fail when a README is stale
 (`rosrun rascal_workcell parameter_tables` rewrites them).
 """
+
 import re
 from typing import Optional
 
@@ -18,8 +19,9 @@ MARKER = re.compile(r"(<!-- BEGIN parameters (\w+) -->\n)(.*?)(<!-- END paramete
 def _default(spec: Spec) -> str:
     if spec.required:
         return "required"
-    return "`%s`" % (spec.default if not isinstance(spec.default, bool)
-                     else str(spec.default).lower())
+    return "`%s`" % (
+        spec.default if not isinstance(spec.default, bool) else str(spec.default).lower()
+    )
 
 
 def _range(spec: Spec) -> str:
@@ -33,19 +35,28 @@ def _range(spec: Spec) -> str:
             text += ", each in " + spec.range_text()
         return text
     if spec.type == "map":
-        return "names" + (" incl. " + ", ".join(spec.required_names)
-                          if spec.required_names else "")
+        return "names" + (" incl. " + ", ".join(spec.required_names) if spec.required_names else "")
     return ""
 
 
 def table(reader: str, schema: Optional[Schema] = None) -> str:
     schema = schema or builtin()
-    rows = ["| parameter | type | unit | default | range | what it sets |",
-            "|---|---|---|---|---|---|"]
+    rows = [
+        "| parameter | type | unit | default | range | what it sets |",
+        "|---|---|---|---|---|---|",
+    ]
     for s in schema.for_reader(reader):
-        rows.append("| `%s` | %s | %s | %s | %s | %s |" % (
-            s.key, s.type, s.unit or "", _default(s), _range(s),
-            s.description.replace("|", "\\|")))
+        rows.append(
+            "| `%s` | %s | %s | %s | %s | %s |"
+            % (
+                s.key,
+                s.type,
+                s.unit or "",
+                _default(s),
+                _range(s),
+                s.description.replace("|", "\\|"),
+            )
+        )
     return "\n".join(rows) + "\n"
 
 

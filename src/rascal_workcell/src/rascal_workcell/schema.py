@@ -6,6 +6,7 @@ depth (type, unit, range, required, unknown keys with the nearest known one) and
 with the defaults filled in. Layout rules that relate several stations (reach, overlap) live in
 rascal_tasks.config, on top of this. No ROS here.
 """
+
 import copy
 import difflib
 import math
@@ -15,8 +16,9 @@ from typing import Any, List, Optional
 
 import yaml
 
-SCHEMA_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "schema",
-                           "parameters.yaml")
+SCHEMA_PATH = os.path.join(
+    os.path.dirname(os.path.abspath(__file__)), "..", "..", "schema", "parameters.yaml"
+)
 UNIT_WORDS = {"m": "metres", "s": "seconds", "rad": "radians", "px": "pixels"}
 READERS = ("rascal", "sim", "arm_controller", "sherd_detector")
 
@@ -61,8 +63,11 @@ class Spec:
                 return "[%s]" % ", ".join("%g" % v for v in b)
             return b if isinstance(b, str) else "%g" % b
 
-        return "%s%s, %s]" % ("(" if self.exclusive_min else "[", show(self.min, "-inf"),
-                              show(self.max, "inf"))
+        return "%s%s, %s]" % (
+            "(" if self.exclusive_min else "[",
+            show(self.min, "-inf"),
+            show(self.max, "inf"),
+        )
 
     def expectation(self) -> str:
         in_unit = " in " + UNIT_WORDS.get(self.unit, self.unit) if self.unit else ""
@@ -166,7 +171,8 @@ class _Validator:
             self.fail(key, spec, v)
         lo, hi = self.bound(spec, "min"), self.bound(spec, "max")
         if (lo is not None and (v < lo or (spec.exclusive_min and v == lo))) or (
-                hi is not None and v > hi):
+            hi is not None and v > hi
+        ):
             shown = copy.copy(spec)
             for which, b in (("min", lo), ("max", hi)):
                 if isinstance(getattr(spec, which), str):
@@ -184,8 +190,12 @@ class _Validator:
             if v not in spec.choices:
                 self.fail(key, spec, v)
         elif t == "string":
-            if (not isinstance(v, str) or not v.strip() or any(ord(c) < 32 for c in v)
-                    or (spec.max_length and len(v) > spec.max_length)):
+            if (
+                not isinstance(v, str)
+                or not v.strip()
+                or any(ord(c) < 32 for c in v)
+                or (spec.max_length and len(v) > spec.max_length)
+            ):
                 self.fail(key, spec, v)
         elif t == "vector":
             if not isinstance(v, list) or len(v) != spec.length:
@@ -199,15 +209,21 @@ class _Validator:
                 self.fail(key, spec, v)
             lo, hi = self.bound(spec, "min"), self.bound(spec, "max")
             for inner in v:
-                if not isinstance(inner, list) or len(inner) != spec.inner_length or not all(
-                        _is_number(e) and lo <= e <= hi for e in inner):
+                if (
+                    not isinstance(inner, list)
+                    or len(inner) != spec.inner_length
+                    or not all(_is_number(e) and lo <= e <= hi for e in inner)
+                ):
                     self.fail(key, spec, v)
 
     def unknown(self, key: str, section: str, known: List[str]):
         name = key.rsplit(".", 1)[-1]
         near = difflib.get_close_matches(name, [k for k in known if k != "*"], n=1, cutoff=0.0)
-        hint = ("did you mean %s?" % ((section + "." if section else "") + near[0])
-                if near else "known keys here: %s" % ", ".join(k for k in known if k != "*"))
+        hint = (
+            "did you mean %s?" % ((section + "." if section else "") + near[0])
+            if near
+            else "known keys here: %s" % ", ".join(k for k in known if k != "*")
+        )
         raise SchemaError(key, "unknown key (a typo? %s)" % hint)
 
     def walk(self, node, prefix: str, station_type: Optional[str] = None) -> dict:
@@ -215,8 +231,9 @@ class _Validator:
         out = {}
         known = self.schema.sections(prefix)
         if not isinstance(node, dict):
-            raise SchemaError(prefix or "(top level)", "expected a mapping of keys, got %r"
-                              % (node,))
+            raise SchemaError(
+                prefix or "(top level)", "expected a mapping of keys, got %r" % (node,)
+            )
         for name, value in node.items():
             key = "%s.%s" % (prefix, name) if prefix else str(name)
             if not isinstance(name, str) or (name not in known and "*" not in known):
@@ -225,13 +242,17 @@ class _Validator:
                 raise SchemaError(key, "names chosen by the site are snake_case words")
             spec = self.schema.find(key)
             if spec is not None and spec.station_types and station_type not in spec.station_types:
-                raise SchemaError(key, "not a key of a %s station (only of %s)" % (
-                    station_type, ", ".join(spec.station_types)))
+                raise SchemaError(
+                    key,
+                    "not a key of a %s station (only of %s)"
+                    % (station_type, ", ".join(spec.station_types)),
+                )
             if spec is not None and spec.type != "map":
                 if value is None:
                     if spec.required:
-                        raise SchemaError(key, "missing; add it (see the shipped "
-                                          "config/rascal.yaml)")
+                        raise SchemaError(
+                            key, "missing; add it (see the shipped " "config/rascal.yaml)"
+                        )
                     value = copy.deepcopy(spec.default)
                 self.check_leaf(key, spec, value)
                 out[name] = value
@@ -241,8 +262,10 @@ class _Validator:
                     raise SchemaError(key, "expected %s, got %r" % (spec.expectation(), value))
                 for req in spec.required_names:
                     if req not in value:
-                        raise SchemaError(key + "." + req, "missing; add it (see the shipped "
-                                          "config/rascal.yaml)")
+                        raise SchemaError(
+                            key + "." + req,
+                            "missing; add it (see the shipped " "config/rascal.yaml)",
+                        )
             st = station_type
             if prefix == "stations":
                 st = value.get("type") if isinstance(value, dict) else None
@@ -272,8 +295,12 @@ class _Validator:
             parts = s.key.split(".")
             if s.type == "map" and s.matches(prefix):
                 return s.required
-            if len(parts) > depth and _prefix_matches(parts[:depth], prefix) and s.required and (
-                    not s.station_types or station_type in s.station_types):
+            if (
+                len(parts) > depth
+                and _prefix_matches(parts[:depth], prefix)
+                and s.required
+                and (not s.station_types or station_type in s.station_types)
+            ):
                 return True
         return False
 

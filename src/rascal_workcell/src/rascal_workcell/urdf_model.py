@@ -1,7 +1,9 @@
 """Joint limits, gripper limits, link lengths and the wrist camera's offset read from the URDF
 (rascal_description/urdf/wx250s.urdf), so no Python module writes them down again. The C++ side
-reads the same file (rascal_workcell::GripperGeometry, rascal_control::KinematicModel). No ROS here: the file is found next to this package, or given.
+reads the same file (rascal_workcell::GripperGeometry, rascal_control::KinematicModel). No ROS
+here: the file is found next to this package, or given.
 """
+
 import functools
 import math
 import os
@@ -9,8 +11,15 @@ from dataclasses import dataclass
 import xml.etree.ElementTree as ET
 from typing import List, Optional, Tuple
 
-URDF_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..",
-                         "rascal_description", "urdf", "wx250s.urdf")
+URDF_PATH = os.path.join(
+    os.path.dirname(os.path.abspath(__file__)),
+    "..",
+    "..",
+    "..",
+    "rascal_description",
+    "urdf",
+    "wx250s.urdf",
+)
 ARM_JOINTS = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
 FINGER_JOINT = "left_finger"
 
@@ -53,15 +62,31 @@ class ArmGeometry:
 
 
 def arm_geometry(urdf_xml: Optional[str] = None) -> ArmGeometry:
-    o = {j: _origin(j, urdf_xml) for j in (
-        "waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate", "ee_arm",
-        "gripper", "gripper_bar", "ee_bar", "ee_gripper")}
+    o = {
+        j: _origin(j, urdf_xml)
+        for j in (
+            "waist",
+            "shoulder",
+            "elbow",
+            "forearm_roll",
+            "wrist_angle",
+            "wrist_rotate",
+            "ee_arm",
+            "gripper",
+            "gripper_bar",
+            "ee_bar",
+            "ee_gripper",
+        )
+    }
     return ArmGeometry(
         shoulder_z=o["waist"][2] + o["shoulder"][2],
         upper_arm=math.hypot(o["elbow"][0], o["elbow"][2]),
         forearm=o["forearm_roll"][0] + o["wrist_angle"][0],
-        wrist_to_ee=sum(o[j][0] for j in ("wrist_rotate", "ee_arm", "gripper", "gripper_bar",
-                                          "ee_bar", "ee_gripper")))
+        wrist_to_ee=sum(
+            o[j][0]
+            for j in ("wrist_rotate", "ee_arm", "gripper", "gripper_bar", "ee_bar", "ee_gripper")
+        ),
+    )
 
 
 def arm_joint_limits(urdf_xml: Optional[str] = None) -> List[Tuple[float, float]]:
