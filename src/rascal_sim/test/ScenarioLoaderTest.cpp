@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ShippedConfig.hpp"
 #include "rascal_sim/MunsellTable.hpp"
 #include "rascal_sim/ScenarioLoader.hpp"
 #include "rascal_sim/SherdMeshBuilder.hpp"
@@ -11,7 +12,7 @@ using namespace rascal_sim;
 
 namespace {
 struct Fixture {
-  WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
+  const WorldLayout& layout = rascal_sim_test::layout();
   MunsellTable munsell{std::string(RASCAL_SIM_DATA_DIR) + "/munsell_soil_hues_grid_renotation.csv"};
 };
 
@@ -38,8 +39,9 @@ TEST(ScenarioLoader, GeneratesSeededSpacedSherdsOnThePickupMat) {
     EXPECT_EQ(a.sherds[i].pose, b.sherds[i].pose);
     Eigen::Vector2d lo, hi;
     worldBox(a.sherds[i], lo, hi);
-    const Eigen::Vector2d mat_lo = f.layout.pickup.position - f.layout.pickup.size / 2;
-    const Eigen::Vector2d mat_hi = f.layout.pickup.position + f.layout.pickup.size / 2;
+    const TableRect& mat = f.layout.station(StationType::Pickup).area;
+    const Eigen::Vector2d mat_lo = mat.centre - mat.size / 2;
+    const Eigen::Vector2d mat_hi = mat.centre + mat.size / 2;
     EXPECT_GE(lo.x(), mat_lo.x() - 1e-9);
     EXPECT_GE(lo.y(), mat_lo.y() - 1e-9);
     EXPECT_LE(hi.x(), mat_hi.x() + 1e-9);

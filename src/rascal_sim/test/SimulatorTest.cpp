@@ -2,9 +2,16 @@
 
 #include <cmath>
 
+#include "ShippedConfig.hpp"
 #include "rascal_sim/Simulator.hpp"
 
 using namespace rascal_sim;
+using rascal_sim_test::gripper;
+using rascal_sim_test::layout;
+
+namespace {
+const Station& scaleStation() { return layout().station(StationType::Scale); }
+}  // namespace
 
 namespace {
 SherdSpec slab(const std::string& name, double x, double y, double density) {
@@ -19,7 +26,7 @@ SherdSpec slab(const std::string& name, double x, double y, double density) {
 }
 
 SimulatorOptions quiet() {
-  SimulatorOptions o;
+  SimulatorOptions o = rascal_sim_test::shipped().options;
   o.wrist_camera = false;
   o.archival_width = 400;  // small archival frames keep the test fast
   o.archival_height = 300;
@@ -28,7 +35,7 @@ SimulatorOptions quiet() {
 }  // namespace
 
 TEST(Simulator, ScaleReadsTheSumOfTheMassesOnIt) {
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());
+  Simulator sim(layout(), quiet());
   Scenario sc;
   sc.sherds = {slab("a", 0.27, -0.03, 1850), slab("b", 0.33, 0.03, 1950)};
   sim.load(sc);
@@ -44,11 +51,32 @@ TEST(Simulator, ScaleReadsTheSumOfTheMassesOnIt) {
   EXPECT_TRUE(r.stable);
 }
 
+TEST(Simulator, AScaleLowerThanItsPlatformThicknessStillWeighs) {
+  // 5 mm: the schema (and check_config) accept it, the node used to refuse anything below 11 mm;
+  // the 10 mm platform reaches below the table top, where nothing collides with it
+  YAML::Node root = YAML::LoadFile(RASCAL_CONFIG_PATH);
+  root["stations"]["scale"]["surface_z"] = 0.005;
+  const SimParameters p = SimParameters::read(rascal_workcell::Parameters(root, "sim"), gripper(), RASCAL_SIM_DATA_DIR);
+  Simulator sim(p.layout, quiet());
+  Scenario sc;
+  sc.sherds = {slab("a", 0.30, 0.0, 1850)};
+  sim.load(sc);
+  ScaleReading r;
+  for (int i = 0; i < 3000; ++i) {
+    sim.step();
+    sim.takeScaleReading(r);
+  }
+  const auto s = sim.groundTruth()[0];
+  EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, 0.005, 0.002);
+  EXPECT_NEAR(r.mass, s.mass, 1e-4) << "truth " << s.mass;
+  EXPECT_TRUE(r.stable);
+}
+
 TEST(Simulator, CaptureIsRefusedWhileTheArmIsInView) {
   SimulatorOptions o = quiet();
   // arm stretched out over the archival camera's station (waist towards (0.31, -0.30))
   o.initial_joints = {std::atan2(-0.30, 0.31), 0.0, 0.0, 0.0, 0.0, 0.0};
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), o);
+  Simulator sim(layout(), o);
   std::string why;
   ASSERT_TRUE(sim.triggerCapture(why)) << why;
   for (int i = 0; i < 300; ++i) sim.step();
@@ -57,7 +85,7 @@ TEST(Simulator, CaptureIsRefusedWhileTheArmIsInView) {
 }
 
 TEST(Simulator, CaptureArrivesShutterPlusTransferLater) {
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());  // sleep pose: out of view
+  Simulator sim(layout(), quiet());  // sleep pose: out of view
   std::string why;
   const double t0 = sim.time();
   ASSERT_TRUE(sim.triggerCapture(why)) << why;
@@ -78,7 +106,7 @@ static JointVector pointingDownAt(double x, double y, double z) {
   for (double sh = -0.5; sh < 1.5; sh += 0.005) {
     for (double el = -1.0; el < 1.6; el += 0.005) {
       JointVector q{waist, sh, el, 0, M_PI / 2 - sh - el, 0};
-      const Eigen::Vector3d p = ArmKinematics::forward(q, 0.037)[kEeGripperLink].translation();
+      const Eigen::Vector3d p = ArmKinematics::forward(q, gripper().finger_max)[kEeGripperLink].translation();
       const double err = std::abs(std::hypot(p.x(), p.y()) - r) + std::abs(p.z() - z);
       if (err < best_err) {
         best_err = err;
@@ -99,7 +127,7 @@ static void closeOn(Simulator& sim, const SherdSpec& s) {
   sc.seed = 3;
   sim.load(sc);
   for (int i = 0; i < 200; ++i) sim.step();
-  sim.commandGripper(0.015);
+  sim.commandGripper(gripper().finger_min);
   for (int i = 0; i < 800; ++i) sim.step();
 }
 
@@ -122,7 +150,7 @@ static void graspAndLift(Simulator& sim, const JointVector& start) {
 TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
   SimulatorOptions o = quiet();
   o.initial_joints = overSherd();
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), o);
+  Simulator sim(layout(), o);
   graspAndLift(sim, o.initial_joints);
   const auto truth = sim.groundTruth()[0];
   EXPECT_TRUE(truth.held);
@@ -137,7 +165,7 @@ TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
 TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {
   SimulatorOptions o = quiet();
   o.initial_joints = overSherd();
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), o);
+  Simulator sim(layout(), o);
   std::string message;
   ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kDropNextGrasp), 0.0, message));
   graspAndLift(sim, o.initial_joints);
@@ -146,14 +174,14 @@ TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {
   EXPECT_FALSE(truth.held);
   EXPECT_LT(truth.pose.translation().z(), 0.03);
   EXPECT_LT(truth.linear_velocity.norm(), 1e-2);
-  EXPECT_LT(sim.fingerPosition(), 0.0155);  // nothing left between the fingers
+  EXPECT_LT(sim.fingerPosition(), gripper().finger_min + 0.0005);  // nothing left between the fingers
 }
 
 /// A square slab (55 x 55 mm) on the scale pan turned 45 degrees from the fingers: its corners
 /// wedge into the fully open fingers (diagonal 78 mm > 74 mm), so the close stops at once and the
-/// sherd is held with the fingers at 0.037 m. The arm starts with ee_gripper_link 8 mm above the
+/// sherd is held with the fingers fully open. The arm starts with ee_gripper_link 8 mm above the
 /// pan and lifts the sherd by 8 mm.
-static void wedgeOnTheScale(Simulator& sim, const WorldLayout& layout) {
+static void wedgeOnTheScale(Simulator& sim) {
   Scenario sc;
   SherdSpec s;
   s.name = "square";
@@ -161,24 +189,24 @@ static void wedgeOnTheScale(Simulator& sim, const WorldLayout& layout) {
   s.thickness = 0.008;
   s.curvature = 4.0;
   s.density = 1900;
-  const double x = layout.scale.position.x(), y = layout.scale.position.y();
+  const double x = scaleStation().area.centre.x(), y = scaleStation().area.centre.y();
   s.pose = {x, y, std::atan2(y, x) + M_PI / 4};
   sc.sherds = {s};
   sc.seed = 3;
   sim.load(sc);
   for (int i = 0; i < 20; ++i) sim.step();  // close before the fingers push it round
-  sim.commandGripper(0.015);
+  sim.commandGripper(gripper().finger_min);
   for (int i = 0; i < 800; ++i) sim.step();
   ASSERT_TRUE(sim.groundTruth()[0].held);
-  ASSERT_GT(sim.fingerPosition(), 0.0365) << "not wedged wide open: the test lost its premise";
+  ASSERT_GT(sim.fingerPosition(), gripper().finger_max - 0.0005) << "not wedged wide open: the test lost its premise";
   TrajectoryPoint p;
-  p.positions = pointingDownAt(x, y, layout.scale_surface_z + 0.016);
+  p.positions = pointingDownAt(x, y, scaleStation().surface_z + 0.016);
   p.time_from_start = 1.0;
   sim.commandArm(sim.time(), {p}, {true, true, true, true, true, true});
   for (int i = 0; i < 1500; ++i) sim.step();
   const auto truth = sim.groundTruth()[0];
   ASSERT_TRUE(truth.held);
-  EXPECT_GT(truth.pose.translation().z() - truth.box_size.z() / 2, layout.scale_surface_z + 0.004);
+  EXPECT_GT(truth.pose.translation().z() - truth.box_size.z() / 2, scaleStation().surface_z + 0.004);
 }
 
 /// Steps up to `seconds`; the sim time at which the sherd came to rest and stayed (-1 if never),
@@ -198,14 +226,13 @@ static double stepUntilRest(Simulator& sim, double seconds, bool& ever_held) {
 }
 
 TEST(Simulator, FullyOpeningReleasesADiagonallyWedgedSherd) {
-  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
   SimulatorOptions o = quiet();
-  o.initial_joints = pointingDownAt(layout.scale.position.x(), layout.scale.position.y(),
-                                    layout.scale_surface_z + 0.008);
-  Simulator sim(layout, o);
-  wedgeOnTheScale(sim, layout);
+  o.initial_joints = pointingDownAt(scaleStation().area.centre.x(), scaleStation().area.centre.y(),
+                                    scaleStation().surface_z + 0.008);
+  Simulator sim(layout(), o);
+  wedgeOnTheScale(sim);
   const double t0 = sim.time();
-  sim.commandGripper(0.037);  // the fingers are already at 0.037: the command alone lets go
+  sim.commandGripper(gripper().finger_max);  // the fingers are already there: the command alone lets go
   sim.step();
   EXPECT_FALSE(sim.groundTruth()[0].held);
   bool ever_held = false;
@@ -214,16 +241,15 @@ TEST(Simulator, FullyOpeningReleasesADiagonallyWedgedSherd) {
   EXPECT_FALSE(ever_held);
   ASSERT_GT(rest_at, 0.0) << "still moving";
   EXPECT_LT(rest_at - t0, 2.0);
-  EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, layout.scale_surface_z, 0.003);
+  EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, scaleStation().surface_z, 0.003);
 }
 
 TEST(Simulator, OpeningPartlyReleasesAWedgedSherdOnTheScaleForGood) {
-  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
   SimulatorOptions o = quiet();
-  o.initial_joints = pointingDownAt(layout.scale.position.x(), layout.scale.position.y(),
-                                    layout.scale_surface_z + 0.008);
-  Simulator sim(layout, o);
-  wedgeOnTheScale(sim, layout);
+  o.initial_joints = pointingDownAt(scaleStation().area.centre.x(), scaleStation().area.centre.y(),
+                                    scaleStation().surface_z + 0.008);
+  Simulator sim(layout(), o);
+  wedgeOnTheScale(sim);
   // the lead's sequence: open to 70.5 mm (less than the wedged 74 mm, so the fingers move in
   // while the sherd is still between them), then fully
   sim.commandGripper(0.03525);
@@ -232,7 +258,7 @@ TEST(Simulator, OpeningPartlyReleasesAWedgedSherdOnTheScaleForGood) {
   bool ever_held = false;
   stepUntilRest(sim, 0.5, ever_held);
   EXPECT_FALSE(ever_held) << "re-attached without a new close";
-  sim.commandGripper(0.037);
+  sim.commandGripper(gripper().finger_max);
   const double rest_at = stepUntilRest(sim, 2.5, ever_held);
   EXPECT_FALSE(ever_held);
   EXPECT_GT(rest_at, 0.0);
@@ -242,23 +268,23 @@ TEST(Simulator, OpeningPartlyReleasesAWedgedSherdOnTheScaleForGood) {
     sim.takeScaleReading(r);
   }
   const auto s = sim.groundTruth()[0];
-  EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, layout.scale_surface_z, 0.003);
+  EXPECT_NEAR(s.pose.translation().z() - s.box_size.z() / 2, scaleStation().surface_z, 0.003);
   EXPECT_TRUE(r.stable);
   EXPECT_NEAR(r.mass, s.mass, 1e-4) << "truth " << s.mass;
   // the next close, back down at grasp height, grasps it again
   TrajectoryPoint down;
-  down.positions = pointingDownAt(layout.scale.position.x(), layout.scale.position.y(),
-                                  layout.scale_surface_z + 0.006);
+  down.positions = pointingDownAt(scaleStation().area.centre.x(), scaleStation().area.centre.y(),
+                                  scaleStation().surface_z + 0.006);
   down.time_from_start = 0.5;
   sim.commandArm(sim.time(), {down}, {true, true, true, true, true, true});
   for (int i = 0; i < 1000; ++i) sim.step();
-  sim.commandGripper(0.015);
+  sim.commandGripper(gripper().finger_min);
   for (int i = 0; i < 800; ++i) sim.step();
   EXPECT_TRUE(sim.groundTruth()[0].held);
 }
 
 TEST(Simulator, ScaleGlitchMakesReadingsUnstable) {
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());
+  Simulator sim(layout(), quiet());
   std::string message;
   EXPECT_FALSE(sim.injectFault(static_cast<int>(Fault::kScaleGlitch), 0.0, message));
   ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kScaleGlitch), 1.0, message));
@@ -276,7 +302,7 @@ TEST(Simulator, ScaleGlitchMakesReadingsUnstable) {
 }
 
 TEST(Simulator, CameraTimeoutFaultAnswersOnlyAfterItsDuration) {
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());
+  Simulator sim(layout(), quiet());
   std::string message;
   ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kCameraTimeout), 1.0, message)) << message;
   std::string why;
@@ -296,12 +322,11 @@ TEST(Simulator, CameraTimeoutFaultAnswersOnlyAfterItsDuration) {
 /// `stop_while_held`, the arm controller's stop (a command to where the fingers are, as on a
 /// cancel, and an empty trajectory) comes while it is held. Returns the sim time of the release.
 static double dropAWedgedSherd(Simulator& sim, bool stop_while_held) {
-  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
   const double x = 0.30, y = 0.20;
   Scenario sc;
   SherdSpec s;
   s.name = "sherd_02";
-  s.mesh_file = layout.data_dir + "/archaide_braccio_frag_1.stl";
+  s.mesh_file = layout().data_dir + "/archaide_braccio_frag_1.stl";
   s.density = 1900;
   s.pose = {x, y, std::atan2(y, x) + M_PI / 4};
   sc.sherds = {s};
@@ -310,10 +335,10 @@ static double dropAWedgedSherd(Simulator& sim, bool stop_while_held) {
   std::string message;
   EXPECT_TRUE(sim.injectFault(static_cast<int>(Fault::kDropNextGrasp), 0.0, message));
   for (int i = 0; i < 20; ++i) sim.step();
-  sim.commandGripper(0.015);
+  sim.commandGripper(gripper().finger_min);
   for (int i = 0; i < 800; ++i) sim.step();
   EXPECT_TRUE(sim.groundTruth()[0].held);
-  EXPECT_GT(sim.fingerPosition(), 0.034) << "not wedged: the test lost its premise";
+  EXPECT_GT(sim.fingerPosition(), gripper().finger_max - 0.003) << "not wedged: the test lost its premise";
   if (stop_while_held) {
     sim.commandGripper(sim.fingerPosition());
     sim.stopGripper();
@@ -342,47 +367,46 @@ static SimulatorOptions overTheFragment() {
 /// 45 degrees from the fingers it still fits the open gripper, as the real one would. A single
 /// bounding box as collision shape (80 mm diagonal) wedged it wide open instead.
 TEST(Simulator, AScannedFragmentAcrossItsDiagonalIsGraspedOnItsOutline) {
-  const WorldLayout layout = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
   SimulatorOptions o = quiet();
   o.initial_joints = pointingDownAt(0.30, 0.20, 0.008);
-  Simulator sim(layout, o);
+  Simulator sim(layout(), o);
   SherdSpec s;
   s.name = "fragment";
-  s.mesh_file = layout.data_dir + "/archaide_braccio_frag_1.stl";
+  s.mesh_file = layout().data_dir + "/archaide_braccio_frag_1.stl";
   s.density = 1900;
   s.pose = {0.30, 0.20, std::atan2(0.20, 0.30) + M_PI / 4};
   closeOn(sim, s);
   EXPECT_TRUE(sim.groundTruth()[0].held);
-  EXPECT_LT(sim.fingerPosition(), 0.036) << "wedged on the corners of a box the sherd does not fill";
+  EXPECT_LT(sim.fingerPosition(), gripper().finger_max - 0.001) << "wedged on the corners of a box the sherd does not fill";
 }
 
 TEST(Simulator, FingersGoOnClosingWhenAWedgedSherdIsDropped) {
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), overTheFragment());
+  Simulator sim(layout(), overTheFragment());
   const double released_at = dropAWedgedSherd(sim, false);
   ASSERT_GT(released_at, 0.0) << "the sherd was never let go";
   while (sim.time() < released_at + 1.0) sim.step();
-  EXPECT_LT(sim.fingerPosition(), 0.016) << "the fingers stayed open after the sherd went";
+  EXPECT_LT(sim.fingerPosition(), gripper().finger_min + 0.001) << "the fingers stayed open after the sherd went";
   EXPECT_FALSE(sim.groundTruth()[0].held);
   EXPECT_LT(sim.groundTruth()[0].pose.translation().z(), 0.03);
 }
 
 TEST(Simulator, AStopWhileSqueezingKeepsTheCloseWhenTheSherdGoes) {
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), overTheFragment());
+  Simulator sim(layout(), overTheFragment());
   const double released_at = dropAWedgedSherd(sim, true);
   ASSERT_GT(released_at, 0.0) << "the sherd was never let go";
   while (sim.time() < released_at + 1.0) sim.step();
-  EXPECT_LT(sim.fingerPosition(), 0.016) << "the fingers stayed open after the sherd went";
+  EXPECT_LT(sim.fingerPosition(), gripper().finger_min + 0.001) << "the fingers stayed open after the sherd went";
   EXPECT_FALSE(sim.groundTruth()[0].held);
   EXPECT_LT(sim.groundTruth()[0].pose.translation().z(), 0.03);
 }
 
 TEST(Simulator, AStopWithNothingBetweenTheFingersStopsThem) {
-  Simulator sim(WorldLayout::defaults(RASCAL_SIM_DATA_DIR), quiet());
-  sim.commandGripper(0.015);
+  Simulator sim(layout(), quiet());
+  sim.commandGripper(gripper().finger_min);
   for (int i = 0; i < 100; ++i) sim.step();
   sim.stopGripper();
   const double stopped = sim.fingerPosition();
-  EXPECT_LT(stopped, 0.0355);
+  EXPECT_LT(stopped, gripper().finger_max - 0.0015);
   for (int i = 0; i < 300; ++i) sim.step();
   EXPECT_NEAR(sim.fingerPosition(), stopped, 1e-9);
 }

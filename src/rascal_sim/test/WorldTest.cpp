@@ -2,9 +2,12 @@
 
 #include <cmath>
 
+#include "ShippedConfig.hpp"
 #include "rascal_sim/World.hpp"
 
 using namespace rascal_sim;
+using rascal_sim_test::gripper;
+using rascal_sim_test::layout;
 
 namespace {
 SherdSpec slab(const std::string& name, double x, double y, double drop = 0.0) {
@@ -21,7 +24,7 @@ SherdSpec slab(const std::string& name, double x, double y, double drop = 0.0) {
 }  // namespace
 
 TEST(World, DroppedSherdComesToRestWithinTwoSeconds) {
-  World world(WorldLayout::defaults(RASCAL_SIM_DATA_DIR));
+  World world(layout(), gripper());
   world.spawn({slab("a", 0.15, 0.25, 0.05)});
   const double z0 = world.sherd(0).pose.translation().z();
   double rest_at = -1;
@@ -39,14 +42,14 @@ TEST(World, DroppedSherdComesToRestWithinTwoSeconds) {
 }
 
 TEST(World, ArmLinkPassingThroughASherdPushesIt) {
-  World world(WorldLayout::defaults(RASCAL_SIM_DATA_DIR));
+  World world(layout(), gripper());
   // gripper pointing down with the fingertips 1 cm above the table, found on a coarse grid
   JointVector best{};
   double best_err = 1e9;
   for (double sh = -0.5; sh < 1.5; sh += 0.01) {
     for (double el = -1.0; el < 1.6; el += 0.01) {
       JointVector q{0, sh, el, 0, M_PI / 2 - sh - el, 0};
-      const auto T = ArmKinematics::forward(q, 0.037);
+      const auto T = ArmKinematics::forward(q, gripper().finger_max);
       const Eigen::Vector3d p = T[kEeGripperLink].translation();
       const double err = std::abs(p.x() - 0.30) + std::abs(p.z() - 0.0);
       if (err < best_err) {
@@ -62,11 +65,11 @@ TEST(World, ArmLinkPassingThroughASherdPushesIt) {
   world.spawn({s});
   JointVector q = best;
   q[0] = -0.5;
-  world.placeArm(q, 0.037);
+  world.placeArm(q, gripper().finger_max);
   const Eigen::Vector3d before = world.sherd(0).pose.translation();
   for (int i = 0; i < 1000; ++i) {
     q[0] = -0.5 + 1.0 * (i + 1) / 1000.0;
-    world.setArmTarget(q, 0.037);
+    world.setArmTarget(q, gripper().finger_max);
     world.step(0.001);
   }
   for (int i = 0; i < 500; ++i) world.step(0.001);

@@ -2,6 +2,7 @@
 
 They use the command-line tools (rostopic, rosservice) so that this process needs no rospy node.
 """
+
 import os
 import struct
 import time
@@ -28,19 +29,26 @@ def joint_positions(master):
 
 def move_arm(master, joints, seconds=2.0):
     msg = "{joint_names: [%s], points: [{positions: [%s], time_from_start: {secs: %d}}]}" % (
-        ", ".join(ARM), ", ".join(str(j) for j in joints), int(seconds))
-    master.run(["rostopic", "pub", "-1", "/arm/joint_trajectory", "trajectory_msgs/JointTrajectory", msg])
+        ", ".join(ARM),
+        ", ".join(str(j) for j in joints),
+        int(seconds),
+    )
+    master.run(
+        ["rostopic", "pub", "-1", "/arm/joint_trajectory", "trajectory_msgs/JointTrajectory", msg]
+    )
     deadline = time.monotonic() + 60.0
     while time.monotonic() < deadline:
         q = joint_positions(master)
-        if all(abs(a - b) < 0.01 for a, b in zip(q[:6], joints)):
+        if all(abs(a - b) < 0.01 for a, b in zip(q[:6], joints, strict=True)):
             return q
         time.sleep(0.2)
     raise AssertionError("arm did not reach %s (at %s)" % (joints, q))
 
 
 def capture(master, path):
-    return master.run(["rosservice", "call", "/archival_camera/capture", "{path: '%s'}" % path]).stdout
+    return master.run(
+        ["rosservice", "call", "/archival_camera/capture", "{path: '%s'}" % path]
+    ).stdout
 
 
 @pytest.fixture
@@ -100,13 +108,27 @@ def test_capture_refused_while_arm_in_view_then_stored(ros_master, sim, tmp_path
 def test_ground_truth_spawn_and_reset(ros_master, sim):
     truth = ros_master.run(["rosservice", "call", "/sim/ground_truth"]).stdout
     assert truth.count("name: \"sherd_0") == 3
-    out = ros_master.run(["rosservice", "call", "/sim/spawn",
-                          "{scenario_file: '', scenario_yaml: 'sherds: [{name: one, pose: [0.1, 0.25, 0]}]'}"]).stdout
+    out = ros_master.run(
+        [
+            "rosservice",
+            "call",
+            "/sim/spawn",
+            "{scenario_file: '', scenario_yaml: 'sherds: [{name: one, pose: [0.1, 0.25, 0]}]'}",
+        ]
+    ).stdout
     assert "success: True" in out and "count: 1" in out
-    out = ros_master.run(["rosservice", "call", "/sim/spawn",
-                          "{scenario_file: '', scenario_yaml: 'sherds: [{pose: [0, 0]}]'}"]).stdout
+    out = ros_master.run(
+        [
+            "rosservice",
+            "call",
+            "/sim/spawn",
+            "{scenario_file: '', scenario_yaml: 'sherds: [{pose: [0, 0]}]'}",
+        ]
+    ).stdout
     assert "success: False" in out and "sherds[0].pose" in out
-    out = ros_master.run(["rosservice", "call", "/sim/inject_fault", "{fault: 1, duration: 1.0}"]).stdout
+    out = ros_master.run(
+        ["rosservice", "call", "/sim/inject_fault", "{fault: 1, duration: 1.0}"]
+    ).stdout
     assert "success: True" in out
     assert "success: True" in ros_master.run(["rosservice", "call", "/sim/reset"]).stdout
 
@@ -117,4 +139,5 @@ def test_bad_parameter_is_named_and_exits_non_zero(ros_master, rosrun):
     proc = rosrun("rascal_sim", "sim")
     out, _ = proc.communicate(timeout=30)
     assert proc.returncode != 0
-    assert "/stations/scale/position" in out
+    named = [line for line in out.splitlines() if "stations.scale.position: expected" in line]
+    assert len(named) == 1, out

@@ -33,9 +33,9 @@ class ArmKinematics {
   static const char* linkName(ArmLink link);
   static constexpr double kMaxVelocity = 3.141592653589793;  ///< [rad/s] timing.md
   static constexpr double kMaxAcceleration = 5.0;            ///< [rad/s^2] timing.md
-  static constexpr double kFingerMin = 0.015, kFingerMax = 0.037;  ///< [m] per finger
 
-  /// Poses of every link in base_link for joints q and left finger position `finger`.
+  /// Poses of every link in base_link for joints q and left finger position `finger` [m] (its
+  /// limits are the URDF's: rascal_workcell::GripperGeometry).
   static std::array<Eigen::Isometry3d, kArmLinkCount> forward(const JointVector& q, double finger);
   /// The boxes of the moving links (and the base) used for contacts, rendering and view checks.
   static const std::vector<LinkBox>& linkBoxes();

@@ -14,13 +14,18 @@
 #include "rascal_sim/SensorEffects.hpp"
 #include "rascal_sim/ServoModel.hpp"
 #include "rascal_sim/World.hpp"
+#include "rascal_workcell/GripperGeometry.hpp"
 
 namespace rascal_sim {
 
+/// Filled from config/rascal.yaml and the URDF by SimParameters::read (node, tests and tools).
 struct SimulatorOptions {
   double physics_dt = 0.001;                         ///< [s]
   JointVector initial_joints{0.0, -1.80, 1.55, 0.0, 0.8, 0.0};  ///< sleep pose
-  double initial_finger = 0.037;                     ///< [m] open
+  /// Finger travel from the URDF (GripperGeometry::fromPackageUrdf()); required: the Simulator
+  /// refuses options without it.
+  rascal_workcell::GripperGeometry gripper;
+  double initial_finger = 0.0;                       ///< [m] left finger, within the gripper's limits
   bool wrist_camera = true;
   double wrist_rate = 30.0;                          ///< [Hz]
   CameraModel wrist_model = CameraModel::wristD435();
@@ -44,6 +49,7 @@ class Simulator {
   /// [m] per finger: a command this much more open than the last one is an open (1 mm opening).
   static constexpr double kReleaseStep = 0.0005;
 
+  /// Throws std::invalid_argument when options.gripper is not set or initial_finger is outside it.
   Simulator(const WorldLayout& layout, const SimulatorOptions& options);
   /// Spawns the scenario's sherds and takes its lighting; remembered for reset().
   void load(const Scenario& scenario);
@@ -56,7 +62,7 @@ class Simulator {
                   const std::array<bool, kArmJoints>& mask);
   /// A target below the previous one closes (and may grasp what both fingers touch); one that
   /// opens (at least kReleaseStep above the previous target and not where the fingers already
-  /// are, or at the fully open 0.037 m, or beyond the fingers) lets a held sherd go at once.
+  /// are, or fully open at gripper.finger_max, or beyond the fingers) lets a held sherd go at once.
   void commandGripper(double finger_position);
   /// Stops the fingers where they are; a held sherd stays held. While the fingers squeeze a
   /// sherd (held, or pressed by both fingers) after a close, a stop (this, or a command to where

@@ -1,6 +1,6 @@
 #pragma once
-// The ODE world: table, station fixtures, the scale platform as its own body, sherds, and the arm
-// as kinematic collision boxes that follow the servos.
+// The ODE world: table, station fixtures (the workcell's collision boxes), the scale platform as
+// its own body, sherds, and the arm as kinematic collision boxes that follow the servos.
 #include <Eigen/Geometry>
 #include <memory>
 #include <string>
@@ -10,6 +10,7 @@
 #include "rascal_sim/Renderer.hpp"
 #include "rascal_sim/Scenario.hpp"
 #include "rascal_sim/WorldLayout.hpp"
+#include "rascal_workcell/GripperGeometry.hpp"
 
 namespace rascal_sim {
 
@@ -33,7 +34,9 @@ struct FingerContacts {
 
 class World {
  public:
-  explicit World(const WorldLayout& layout);
+  /// Static fixtures from layout.workcell.collisionBoxes(); the arm starts at the sleep pose with
+  /// the fingers fully open (gripper.finger_max).
+  World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& gripper);
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;

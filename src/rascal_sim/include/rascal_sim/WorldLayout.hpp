@@ -1,39 +1,33 @@
 #pragma once
-// Station layout of the simulated table, filled from config/rascal.yaml (stations.*, simulator.*)
-// by the node, or built directly by tests.
-#include <Eigen/Geometry>
+// What the simulated table looks like: the rig's one workcell model (rascal_workcell::Workcell,
+// stations found by type, fixture boxes computed once from config/rascal.yaml) plus what only the
+// simulator needs: colours and the folder of its data files.
+#include <Eigen/Core>
 #include <array>
 #include <string>
 
+#include "rascal_workcell/Parameters.hpp"
+#include "rascal_workcell/Workcell.hpp"
+
 namespace rascal_sim {
 
-/// A rectangle on the table: centre and size [along x, along y] in base_link, metres.
-struct TableRect {
-  Eigen::Vector2d position{0.0, 0.0};
-  Eigen::Vector2d size{0.0, 0.0};
-};
+using rascal_workcell::Station;
+using rascal_workcell::StationType;
+using rascal_workcell::TableRect;
 
 struct WorldLayout {
-  TableRect pickup;
-  TableRect scale;                 ///< weighing platform
-  double scale_surface_z = 0.025;  ///< platform top above the table
-  TableRect camera;                ///< archival camera's field of view on the table
-  Eigen::Vector2d camera_place_at{0.28, -0.30};
-  double camera_height = 0.55;     ///< lens above the camera station surface
-  TableRect colour_chart;
-  TableRect scale_bar;
-  TableRect stand;                 ///< the archival camera's post (collision fixture)
-  double stand_height = 0.60;
-  TableRect discard;
-  double discard_wall_height = 0.04;
-  Eigen::Vector3d table_colour{0.55, 0.50, 0.42};  ///< sRGB [0, 1]
-  Eigen::Vector3d mat_colour{0.10, 0.22, 0.55};
-  std::array<Eigen::Vector3d, 2> scale_colours{Eigen::Vector3d(0.85, 0.85, 0.85),
-                                               Eigen::Vector3d(0.25, 0.25, 0.25)};
-  std::string data_dir;            ///< folder with the colour chart CSV, Munsell CSV, fragment STL
+  rascal_workcell::Workcell workcell;
+  Eigen::Vector3d table_colour{0.0, 0.0, 0.0};  ///< sRGB [0, 1] (simulator.table_colour)
+  Eigen::Vector3d mat_colour{0.0, 0.0, 0.0};    ///< pickup and discard mats (simulator.mat_colour)
+  std::array<Eigen::Vector3d, 2> scale_colours{};  ///< platform pan, rim (simulator.scale_colours)
+  std::string data_dir;  ///< folder with the colour chart CSV, Munsell CSV, fragment STL
 
-  /// The values of config/rascal.yaml as shipped (for tests and tools).
-  static WorldLayout defaults(const std::string& data_dir);
+  /// The one station of a type (the workcell checked that there is exactly one).
+  const Station& station(StationType type) const { return workcell.station(type); }
+
+  /// Reads `stations.*` (through Workcell::fromParameters) and the simulator's colours; throws
+  /// rascal_workcell::ParameterError naming the key.
+  static WorldLayout fromParameters(const rascal_workcell::Parameters& params, const std::string& data_dir);
 };
 
 }  // namespace rascal_sim

@@ -7,9 +7,10 @@ namespace rascal_sim {
 ArchivalCamera::ArchivalCamera(const WorldLayout& layout, int width, int height) {
   model_.width = width;
   model_.height = height;
-  const double h = layout.camera_height;
-  // the field of view covers the station rectangle (config stations.camera.size)
-  const double f = std::min(width * h / layout.camera.size.x(), height * h / layout.camera.size.y());
+  const Station& station = layout.station(StationType::ArchivalCamera);
+  const double h = station.camera_height;
+  // the field of view covers the station rectangle (the archival camera station's size)
+  const double f = std::min(width * h / station.area.size.x(), height * h / station.area.size.y());
   model_.fx = model_.fy = f;
   model_.cx = width / 2.0;
   model_.cy = height / 2.0;
@@ -20,7 +21,7 @@ ArchivalCamera::ArchivalCamera(const WorldLayout& layout, int width, int height)
   Eigen::Matrix3d r;
   r << 1, 0, 0, 0, -1, 0, 0, 0, -1;
   world_T_camera_.linear() = r;
-  world_T_camera_.translation() = Eigen::Vector3d(layout.camera.position.x(), layout.camera.position.y(), h);
+  world_T_camera_.translation() = Eigen::Vector3d(station.area.centre.x(), station.area.centre.y(), h);
 }
 
 bool ArchivalCamera::trigger(double now, bool camera_fault, double fault_until, std::string& why) {

@@ -3,24 +3,21 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rascal_sim/ArmKinematics.hpp"
-
 namespace rascal_sim {
 
-namespace {
-constexpr double kSpeed = (ArmKinematics::kFingerMax - ArmKinematics::kFingerMin) / GripperModel::kStrokeTime;
+GripperModel::GripperModel(const rascal_workcell::GripperGeometry& gripper, double initial)
+    : min_(gripper.finger_min),
+      max_(gripper.finger_max),
+      speed_((gripper.finger_max - gripper.finger_min) / kStrokeTime),
+      q_(clamp(initial)),
+      target_(q_) {}
 
-double clampFinger(double p) {
-  return std::min(ArmKinematics::kFingerMax, std::max(ArmKinematics::kFingerMin, p));
-}
-}  // namespace
+double GripperModel::clamp(double p) const { return std::min(max_, std::max(min_, p)); }
 
-GripperModel::GripperModel(double initial) : q_(clampFinger(initial)), target_(q_) {}
-
-void GripperModel::setTarget(double finger_position) { target_ = clampFinger(finger_position); }
+void GripperModel::setTarget(double finger_position) { target_ = clamp(finger_position); }
 
 void GripperModel::reset(double position) {
-  q_ = clampFinger(position);
+  q_ = clamp(position);
   target_ = q_;
   v_ = 0.0;
 }
@@ -31,7 +28,7 @@ void GripperModel::step(double dt, bool blocked) {
     v_ = 0.0;
     return;
   }
-  const double move = std::copysign(std::min(std::abs(err), kSpeed * dt), err);
+  const double move = std::copysign(std::min(std::abs(err), speed_ * dt), err);
   q_ += move;
   v_ = move / dt;
 }

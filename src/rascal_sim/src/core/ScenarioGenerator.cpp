@@ -138,8 +138,8 @@ std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) co
     yaw += jitter + ((rng() % 2) ? kPi : 0.0);
     const Eigen::Vector2d ext = turnedExtents(length, width, yaw);
     const int r = i / cols, c = i % cols;
-    Eigen::Vector2d centre(o.area.position.x() - o.area.size.x() / 2 + (c + 0.5) * cell.x(),
-                           o.area.position.y() - o.area.size.y() / 2 + (r + 0.5) * cell.y());
+    Eigen::Vector2d centre(o.area.centre.x() - o.area.size.x() / 2 + (c + 0.5) * cell.x(),
+                           o.area.centre.y() - o.area.size.y() / 2 + (r + 0.5) * cell.y());
     const Eigen::Vector2d slack = (cell - ext - Eigen::Vector2d::Constant(o.min_spacing)).cwiseMax(0.0);
     centre.x() += uniform(rng, -slack.x() / 2, slack.x() / 2 + 1e-12);
     centre.y() += uniform(rng, -slack.y() / 2, slack.y() / 2 + 1e-12);

@@ -45,12 +45,15 @@ std::vector<double> numbers(const YAML::Node& node, const std::string& key, size
   return v;
 }
 
-TableRect station(const WorldLayout& l, const std::string& name, const std::string& key) {
-  if (name == "pickup") return l.pickup;
-  if (name == "scale") return l.scale;
-  if (name == "camera") return l.camera;
-  if (name == "discard") return l.discard;
-  fail(key, "unknown station '" + name + "' (pickup, scale, camera, discard)");
+/// A station by its type (`camera` is the archival camera's), never by the site's name for it.
+TableRect station(const WorldLayout& l, const std::string& type, const std::string& key) {
+  StationType t = StationType::Pickup;
+  try {
+    t = rascal_workcell::stationTypeFromString(type == "camera" ? "archival_camera" : type);
+  } catch (const std::invalid_argument&) {
+    fail(key, "unknown station type '" + type + "' (pickup, scale, camera, discard)");
+  }
+  return l.station(t).area;
 }
 }  // namespace
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "rascal_sim/SherdMeshBuilder.hpp"
 
@@ -9,14 +11,29 @@ namespace rascal_sim {
 
 namespace {
 constexpr double kExposure = 0.01;  // [s] wrist colour exposure used for the blur length
+
+const SimulatorOptions& checked(const SimulatorOptions& o) {
+  const auto& g = o.gripper;
+  if (!(g.finger_min > 0.0 && g.finger_max > g.finger_min)) {
+    throw std::invalid_argument(
+        "Simulator: SimulatorOptions::gripper has no finger limits; fill it from "
+        "rascal_workcell::GripperGeometry::fromPackageUrdf() (SimParameters::read does)");
+  }
+  if (!(o.initial_finger >= g.finger_min && o.initial_finger <= g.finger_max)) {
+    throw std::invalid_argument("Simulator: SimulatorOptions::initial_finger " + std::to_string(o.initial_finger) +
+                                " m is outside the finger limits [" + std::to_string(g.finger_min) + ", " +
+                                std::to_string(g.finger_max) + "] m");
+  }
+  return o;
+}
 }  // namespace
 
 Simulator::Simulator(const WorldLayout& layout, const SimulatorOptions& options)
     : layout_(layout),
-      options_(options),
-      world_(layout),
+      options_(checked(options)),
+      world_(layout, options.gripper),
       servos_(options.initial_joints),
-      gripper_(options.initial_finger),
+      gripper_(options.gripper, options.initial_finger),
       scale_(7),
       archival_(layout, options.archival_width, options.archival_height),
       effects_(11),
@@ -65,7 +82,7 @@ void Simulator::commandGripper(double finger_position) {
     // an open, even to less than where a sherd wedged the fingers (not a stop where they are)
     close_armed_ = false;
     open_requested_ = true;
-  } else if (target >= ArmKinematics::kFingerMax - 1e-6) {
+  } else if (target >= gripper_.fingerMax() - 1e-6) {
     close_armed_ = false;
     open_requested_ = true;
   } else if (target > previous && squeezed) {
@@ -116,7 +133,7 @@ void Simulator::updateGrasp() {
   if (held >= 0) {
     // the fixed joint holds only while the fingers press on the sherd: any open lets it go,
     // and it never stays attached to fingers commanded fully open
-    if (open_requested_ || gripper_.opening() || gripper_.target() >= ArmKinematics::kFingerMax - 1e-6) {
+    if (open_requested_ || gripper_.opening() || gripper_.target() >= gripper_.fingerMax() - 1e-6) {
       releaseByOpening();
       return;
     }

@@ -2,6 +2,7 @@
 
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <mutex>
@@ -13,9 +14,39 @@
 namespace rascal_sim {
 
 namespace {
+using rascal_workcell::FixtureBox;
+using rascal_workcell::Workcell;
+
 constexpr double kGravity = 9.81;
-constexpr double kPlatformMass = 0.30;       // [kg] the weighing pan (tared away)
-constexpr double kPlatformThickness = 0.010;  // [m]
+constexpr double kPlatformMass = 0.30;  // [kg] the weighing pan (tared away)
+
+/// The weighing platform, the simulator's own body: the scale station's area, the workcell's
+/// platform thickness, its top at the station's surface_z. A scale standing lower than that
+/// thickness has the rest of its platform below the table top, where nothing collides with it.
+struct PlatformBox {
+  Eigen::Vector3d centre, size;
+};
+
+PlatformBox platformBox(const Station& scale) {
+  const double t = Workcell::kScalePlatformThickness;
+  return {{scale.area.centre.x(), scale.area.centre.y(), scale.surface_z - t / 2},
+          {scale.area.size.x(), scale.area.size.y(), t}};
+}
+
+/// Colour of a fixture box, by the type of the station it belongs to.
+Eigen::Vector3d fixtureColour(const WorldLayout& l, const FixtureBox& b) {
+  const Station* s = l.workcell.find(b.station);
+  if (s && s->type == StationType::Scale) return l.scale_colours[1] * 0.8;  // housing
+  if (s && s->type == StationType::ArchivalCamera) return {0.3, 0.3, 0.32};  // stand
+  if (s && s->type == StationType::Discard) return {0.45, 0.40, 0.33};       // box walls
+  return {0.5, 0.5, 0.5};
+}
+
+/// The scale's platform among the collision boxes (its support surface): the simulator's body.
+bool isPlatform(const WorldLayout& l, const FixtureBox& b) {
+  const Station* s = l.workcell.find(b.station);
+  return b.is_support && s && s->type == StationType::Scale;
+}
 
 struct GeomTag {
   enum Kind { kTable, kStatic, kPlatform, kSherd, kArm, kLeftFinger, kRightFinger } kind;
@@ -74,6 +105,7 @@ struct World::Impl {
   int held = -1;
   FingerContacts contacts_now, contacts_last;
   Mesh fixtures;
+  std::vector<FixtureBox> boxes;  // the workcell's collision boxes, computed once
   double time = 0.0;
 
   GeomTag* tag(GeomTag::Kind k, int i) {
@@ -155,86 +187,85 @@ struct World::Impl {
     Mesh& m = fixtures;
     m.addRect(0.25, 0.0, 1.3, 1.5, 0.0, l.table_colour);
     const double mz = 0.0004;
-    m.addRect(l.pickup.position.x(), l.pickup.position.y(), l.pickup.size.x(), l.pickup.size.y(), mz, l.mat_colour);
-    m.addRect(l.discard.position.x(), l.discard.position.y(), l.discard.size.x(), l.discard.size.y(), mz, l.mat_colour);
-    // scale: housing and the two-tone platform (dark rim, light pan)
-    const Eigen::Vector3d sc(l.scale.position.x(), l.scale.position.y(), 0.0);
-    const double top = l.scale_surface_z;
-    const double housing_h = top - kPlatformThickness;
-    m.addBox({sc.x(), sc.y(), housing_h / 2}, {l.scale.size.x() + 0.03, l.scale.size.y() + 0.03, housing_h},
-             l.scale_colours[1] * 0.8);
-    m.addBox({sc.x(), sc.y(), top - kPlatformThickness / 2}, {l.scale.size.x(), l.scale.size.y(), kPlatformThickness},
-             l.scale_colours[1]);
-    m.addRect(sc.x(), sc.y(), l.scale.size.x() - 0.02, l.scale.size.y() - 0.02, top + 0.0003, l.scale_colours[0]);
+    for (const Station& s : l.workcell.stations()) {
+      if (s.type == StationType::Pickup || s.type == StationType::Discard) {
+        m.addRect(s.area.centre.x(), s.area.centre.y(), s.area.size.x(), s.area.size.y(), mz, l.mat_colour);
+      }
+    }
+    // fixtures standing on the table: scale housing, camera stand post, discard box walls
+    for (const FixtureBox& b : boxes) {
+      if (!isPlatform(l, b)) m.addBox(b.centre, b.size, fixtureColour(l, b));
+    }
+    // scale platform: dark rim, light pan
+    const Station& scale = l.station(StationType::Scale);
+    const PlatformBox pb = platformBox(scale);
+    m.addBox(pb.centre, pb.size, l.scale_colours[1]);
+    if ((scale.area.size.array() > 0.02).all()) {
+      m.addRect(pb.centre.x(), pb.centre.y(), scale.area.size.x() - 0.02, scale.area.size.y() - 0.02,
+                scale.surface_z + 0.0003, l.scale_colours[0]);
+    }
     // colour chart: black card with 4 x 6 patches, row 1 at +y
-    const auto& cc = l.colour_chart;
-    m.addRect(cc.position.x(), cc.position.y(), cc.size.x(), cc.size.y(), 0.0008, {0.05, 0.05, 0.05});
+    const Station& camera = l.station(StationType::ArchivalCamera);
+    const TableRect& cc = camera.colour_chart;
+    m.addRect(cc.centre.x(), cc.centre.y(), cc.size.x(), cc.size.y(), 0.0008, {0.05, 0.05, 0.05});
     const auto patches = MunsellTable::readColourChecker(l.data_dir + "/colorchecker24_xrite_after2014_D50.csv");
     const double pw = cc.size.x() / 6, ph = cc.size.y() / 4;
     for (int r = 0; r < 4; ++r) {
       for (int c = 0; c < 6; ++c) {
-        const double x = cc.position.x() - cc.size.x() / 2 + (c + 0.5) * pw;
-        const double y = cc.position.y() + cc.size.y() / 2 - (r + 0.5) * ph;
+        const double x = cc.centre.x() - cc.size.x() / 2 + (c + 0.5) * pw;
+        const double y = cc.centre.y() + cc.size.y() / 2 - (r + 0.5) * ph;
         m.addRect(x, y, pw * 0.8, ph * 0.8, 0.0012, patches[r * 6 + c]);
       }
     }
     // scale bar: 10 cm, two rows; -x half a 1 cm chequer, +x half black over white
-    const auto& sb = l.scale_bar;
+    const TableRect& sb = camera.scale_bar;
     const double row = sb.size.y() / 2, cell = sb.size.x() / 10;
     for (int i = 0; i < 10; ++i) {
       for (int r = 0; r < 2; ++r) {
-        const double x = sb.position.x() - sb.size.x() / 2 + (i + 0.5) * cell;
-        const double y = sb.position.y() + (r == 0 ? row / 2 : -row / 2);
+        const double x = sb.centre.x() - sb.size.x() / 2 + (i + 0.5) * cell;
+        const double y = sb.centre.y() + (r == 0 ? row / 2 : -row / 2);
         const bool black = i < 5 ? ((i + r) % 2 == 0) : (r == 0);
         m.addRect(x, y, cell, row, 0.0008, black ? Eigen::Vector3d(0.04, 0.04, 0.04) : Eigen::Vector3d(0.95, 0.95, 0.95));
       }
     }
-    // camera stand: post, boom and camera body above the lens
-    const double lens = l.camera_height;
-    m.addBox({l.stand.position.x(), l.stand.position.y(), l.stand_height / 2},
-             {l.stand.size.x(), l.stand.size.y(), l.stand_height}, {0.3, 0.3, 0.32});
-    const double boom_x0 = l.camera.position.x(), boom_x1 = l.stand.position.x();
-    m.addBox({(boom_x0 + boom_x1) / 2, l.camera.position.y(), lens + 0.06}, {boom_x1 - boom_x0, 0.03, 0.02},
+    // camera stand: boom from the post and camera body above the lens (the post is a fixture box)
+    const double lens = camera.camera_height;
+    const double boom_x0 = camera.area.centre.x(), boom_x1 = camera.stand.centre.x();
+    m.addBox({(boom_x0 + boom_x1) / 2, camera.area.centre.y(), lens + 0.06}, {boom_x1 - boom_x0, 0.03, 0.02},
              {0.3, 0.3, 0.32});
-    m.addBox({l.camera.position.x(), l.camera.position.y(), lens + 0.035}, {0.11, 0.07, 0.07}, {0.08, 0.08, 0.08});
-    // discard box walls
-    const auto& d = l.discard;
-    const double w = 0.005, h = l.discard_wall_height;
-    const Eigen::Vector3d grey(0.45, 0.40, 0.33);
-    m.addBox({d.position.x(), d.position.y() + d.size.y() / 2, h / 2}, {d.size.x() + w, w, h}, grey);
-    m.addBox({d.position.x(), d.position.y() - d.size.y() / 2, h / 2}, {d.size.x() + w, w, h}, grey);
-    m.addBox({d.position.x() + d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h}, grey);
-    m.addBox({d.position.x() - d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h}, grey);
+    m.addBox({camera.area.centre.x(), camera.area.centre.y(), lens + 0.035}, {0.11, 0.07, 0.07}, {0.08, 0.08, 0.08});
   }
 
-  void buildPhysics(const WorldLayout& l) {
-    dGeomID plane = dCreatePlane(space, 0, 0, 1, 0);
-    dGeomSetData(plane, tag(GeomTag::kTable, 0));
-    const double top = l.scale_surface_z;
-    const double housing_h = top - kPlatformThickness;
-    staticBox({l.scale.position.x(), l.scale.position.y(), housing_h / 2},
-              {l.scale.size.x() + 0.03, l.scale.size.y() + 0.03, housing_h});
+  void buildPlatform(const Station& scale) {
+    const PlatformBox pb = platformBox(scale);
     platform = dBodyCreate(world);
     dMass m;
-    dMassSetBoxTotal(&m, kPlatformMass, l.scale.size.x(), l.scale.size.y(), kPlatformThickness);
+    dMassSetBoxTotal(&m, kPlatformMass, pb.size.x(), pb.size.y(), pb.size.z());
     dBodySetMass(platform, &m);
-    dBodySetPosition(platform, l.scale.position.x(), l.scale.position.y(), top - kPlatformThickness / 2);
+    dBodySetPosition(platform, pb.centre.x(), pb.centre.y(), pb.centre.z());
     dBodySetAutoDisableFlag(platform, 0);
-    dGeomID pg = dCreateBox(space, l.scale.size.x(), l.scale.size.y(), kPlatformThickness);
+    dGeomID pg = dCreateBox(space, pb.size.x(), pb.size.y(), pb.size.z());
     dGeomSetBody(pg, platform);
     dGeomSetData(pg, tag(GeomTag::kPlatform, 0));
     platform_joint = dJointCreateFixed(world, nullptr);
     dJointAttach(platform_joint, platform, nullptr);
     dJointSetFixed(platform_joint);
     dJointSetFeedback(platform_joint, &platform_feedback);
-    staticBox({l.stand.position.x(), l.stand.position.y(), l.stand_height / 2},
-              {l.stand.size.x(), l.stand.size.y(), l.stand_height});
-    const auto& d = l.discard;
-    const double w = 0.005, h = l.discard_wall_height;
-    staticBox({d.position.x(), d.position.y() + d.size.y() / 2, h / 2}, {d.size.x() + w, w, h});
-    staticBox({d.position.x(), d.position.y() - d.size.y() / 2, h / 2}, {d.size.x() + w, w, h});
-    staticBox({d.position.x() + d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h});
-    staticBox({d.position.x() - d.size.x() / 2, d.position.y(), h / 2}, {w, d.size.y() + w, h});
+  }
+
+  void buildPhysics(const WorldLayout& l) {
+    dGeomID plane = dCreatePlane(space, 0, 0, 1, 0);
+    dGeomSetData(plane, tag(GeomTag::kTable, 0));
+    // static fixtures in the workcell's order; the platform is a body of its own (the scale's
+    // load is its joint's support force)
+    for (const FixtureBox& b : boxes) {
+      if (isPlatform(l, b)) {
+        buildPlatform(l.station(StationType::Scale));
+      } else {
+        staticBox(b.centre, b.size);
+      }
+    }
+    if (!platform) buildPlatform(l.station(StationType::Scale));  // a scale at table height
     // arm: one kinematic body per link that carries boxes
     link_bodies.assign(kArmLinkCount, nullptr);
     for (const LinkBox& b : ArmKinematics::linkBoxes()) {
@@ -282,7 +313,8 @@ struct World::Impl {
   }
 };
 
-World::World(const WorldLayout& layout) : impl_(new Impl), layout_(layout) {
+World::World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& gripper)
+    : impl_(new Impl), layout_(layout) {
   odeInitOnce();
   Impl& w = *impl_;
   w.world = dWorldCreate();
@@ -300,12 +332,13 @@ World::World(const WorldLayout& layout) : impl_(new Impl), layout_(layout) {
   dWorldSetAutoDisableTime(w.world, 0);
   w.space = dHashSpaceCreate(nullptr);
   w.contact_group = dJointGroupCreate(0);
+  w.boxes = layout.workcell.collisionBoxes();
   w.buildFixtures(layout);
   w.fixtures.cull_back_faces = true;  // boxes wound outwards, rectangles face up
   w.fixtures.updateBounds();
   w.buildPhysics(layout);
   JointVector q{0.0, -1.80, 1.55, 0.0, 0.8, 0.0};
-  placeArm(q, ArmKinematics::kFingerMax);
+  placeArm(q, gripper.finger_max);
 }
 
 World::~World() {
@@ -343,10 +376,11 @@ void World::spawn(const std::vector<SherdSpec>& sherds) {
     dMassSetBoxTotal(&m, s->geo.mass, size.x(), size.y(), size.z());
     dBodySetMass(s->body, &m);
     const double x = s->spec.pose.x(), y = s->spec.pose.y();
-    double support = 0.0;
-    if (std::abs(x - layout_.scale.position.x()) < layout_.scale.size.x() / 2 &&
-        std::abs(y - layout_.scale.position.y()) < layout_.scale.size.y() / 2) {
-      support = layout_.scale_surface_z;
+    double support = 0.0;  // the table, or a support surface (the scale platform) under it
+    for (const FixtureBox& b : w.boxes) {
+      if (b.is_support && std::abs(x - b.centre.x()) < b.size.x() / 2 && std::abs(y - b.centre.y()) < b.size.y() / 2) {
+        support = std::max(support, b.centre.z() + b.size.z() / 2);
+      }
     }
     dBodySetPosition(s->body, x, y, support + size.z() / 2 + s->spec.drop_height + 1e-4);
     dMatrix3 r;

@@ -1,54 +1,31 @@
 #include "Conversions.hpp"
 
+#include <cv_bridge/cv_bridge.h>
+#include <sensor_msgs/distortion_models.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_eigen/tf2_eigen.h>
 
+#include <algorithm>
 #include <cstdint>
-
-#include <cstring>
 
 namespace rascal_sim {
 namespace conversions {
 
-geometry_msgs::Pose toPose(const Eigen::Isometry3d& t) {
-  geometry_msgs::Pose p;
-  p.position.x = t.translation().x();
-  p.position.y = t.translation().y();
-  p.position.z = t.translation().z();
-  const Eigen::Quaterniond q(t.linear());
-  p.orientation.x = q.x();
-  p.orientation.y = q.y();
-  p.orientation.z = q.z();
-  p.orientation.w = q.w();
-  return p;
-}
-
 geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& t, const std::string& parent,
                                             const std::string& child, const ros::Time& stamp) {
-  geometry_msgs::TransformStamped m;
+  geometry_msgs::TransformStamped m = tf2::eigenToTransform(t);
   m.header.frame_id = parent;
   m.header.stamp = stamp;
   m.child_frame_id = child;
-  const geometry_msgs::Pose p = toPose(t);
-  m.transform.translation.x = p.position.x;
-  m.transform.translation.y = p.position.y;
-  m.transform.translation.z = p.position.z;
-  m.transform.rotation = p.orientation;
   return m;
 }
 
-sensor_msgs::Image toImage(const cv::Mat& image, const std::string& encoding, const std::string& frame,
-                           const ros::Time& stamp) {
-  sensor_msgs::Image m;
-  m.header.frame_id = frame;
-  m.header.stamp = stamp;
-  m.height = static_cast<uint32_t>(image.rows);
-  m.width = static_cast<uint32_t>(image.cols);
-  m.encoding = encoding;
-  m.is_bigendian = 0;
-  m.step = static_cast<uint32_t>(image.cols * image.elemSize());
-  m.data.resize(static_cast<size_t>(m.step) * m.height);
-  for (int r = 0; r < image.rows; ++r) std::memcpy(&m.data[r * m.step], image.ptr(r), m.step);
-  return m;
+sensor_msgs::ImagePtr toImage(const cv::Mat& image, const std::string& encoding, const std::string& frame,
+                              const ros::Time& stamp) {
+  std_msgs::Header header;
+  header.frame_id = frame;
+  header.stamp = stamp;
+  return cv_bridge::CvImage(header, encoding, image).toImageMsg();
 }
 
 sensor_msgs::CameraInfo toCameraInfo(const CameraModel& cam, const std::string& frame, const ros::Time& stamp) {
@@ -57,7 +34,7 @@ sensor_msgs::CameraInfo toCameraInfo(const CameraModel& cam, const std::string& 
   m.header.stamp = stamp;
   m.width = static_cast<uint32_t>(cam.width);
   m.height = static_cast<uint32_t>(cam.height);
-  m.distortion_model = "plumb_bob";
+  m.distortion_model = sensor_msgs::distortion_models::PLUMB_BOB;
   m.D.assign(5, 0.0);
   m.K = {cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1};
   m.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -103,7 +80,7 @@ sensor_msgs::PointCloud2 toPointCloud(const cv::Mat& depth_mm, const cv::Mat& rg
 rascal_msgs::SherdTruth toTruth(const SherdState& s) {
   rascal_msgs::SherdTruth t;
   t.name = s.name;
-  t.pose = toPose(s.pose);
+  t.pose = tf2::toMsg(s.pose);
   t.mass = s.mass;
   t.thickness = s.thickness;
   t.length = s.length;

@@ -13,8 +13,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "Conversions.hpp"
-#include "ParamReader.hpp"
 #include "rascal_sim/ScenarioLoader.hpp"
+#include "rascal_workcell/GripperGeometry.hpp"
+#include "rascal_workcell/ParameterServer.hpp"
 
 namespace rascal_sim {
 
@@ -31,20 +32,20 @@ std::string resolve(const std::string& root, const std::string& path) {
 }
 }  // namespace
 
-SimNode::SimNode(ros::NodeHandle& nh) {
+SimNode::SimNode(ros::NodeHandle&) {
   // image buffers are allocated every frame: keep them on the heap instead of fresh mmap pages
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
-  readParameters(nh);
-  munsell_ = std::make_unique<MunsellTable>(layout_.data_dir + "/munsell_soil_hues_grid_renotation.csv");
-  ScenarioLoader loader(layout_, *munsell_);
+  readParameters();
+  munsell_ = std::make_unique<MunsellTable>(config_.layout.data_dir + "/munsell_soil_hues_grid_renotation.csv");
+  ScenarioLoader loader(config_.layout, *munsell_);
   Scenario scenario;
   try {
     scenario = loader.load(scenario_path_);
   } catch (const std::exception& e) {
-    throw ParamError("parameter /simulator/scenario: " + std::string(e.what()));
+    throw rascal_workcell::ParameterError("simulator.scenario: " + std::string(e.what()));
   }
-  sim_ = std::make_unique<Simulator>(layout_, options_);
+  sim_ = std::make_unique<Simulator>(config_.layout, config_.options);
   sim_->load(scenario);
 
   ros::NodeHandle root;
@@ -65,65 +66,24 @@ SimNode::SimNode(ros::NodeHandle& nh) {
   reset_srv_ = root.advertiseService("/sim/reset", &SimNode::onReset, this);
   fault_srv_ = root.advertiseService("/sim/inject_fault", &SimNode::onInjectFault, this);
 
+  const Station& station = config_.layout.station(StationType::Scale);
   Eigen::Isometry3d scale = Eigen::Isometry3d::Identity();
-  scale.translation() = Eigen::Vector3d(layout_.scale.position.x(), layout_.scale.position.y(), layout_.scale_surface_z);
+  scale.translation() = Eigen::Vector3d(station.area.centre.x(), station.area.centre.y(), station.surface_z);
   static_tf_.sendTransform({conversions::toTransform(sim_->archival().pose(), "base_link",
                                                      "archival_camera_optical_frame", ros::Time(0)),
                             conversions::toTransform(scale, "base_link", "scale_link", ros::Time(0))});
   ROS_INFO_STREAM("sim: started with scenario " << scenario.name << " (" << scenario.sherds.size()
-                  << " sherds), real_time_factor " << real_time_factor_ << ", wrist camera "
-                  << (options_.wrist_camera ? "on" : "off"));
+                  << " sherds), real_time_factor " << config_.real_time_factor << ", wrist camera "
+                  << (config_.options.wrist_camera ? "on" : "off"));
 }
 
-void SimNode::readParameters(ros::NodeHandle&) {
-  ParamReader p{ros::NodeHandle()};
+void SimNode::readParameters() {
   const std::string pkg = ros::package::getPath("rascal_sim");
   workspace_ = fs::path(pkg).parent_path().parent_path().string();
-  layout_.data_dir = pkg + "/data";
-  layout_.pickup = {p.vec2("/stations/pickup/position"), p.vec2("/stations/pickup/size")};
-  layout_.scale = {p.vec2("/stations/scale/position"), p.vec2("/stations/scale/size")};
-  layout_.scale_surface_z = p.number("/stations/scale/surface_z", 0.011, 0.2);
-  layout_.camera = {p.vec2("/stations/camera/position"), p.vec2("/stations/camera/size")};
-  layout_.camera_place_at = p.vec2("/stations/camera/place_at");
-  layout_.camera_height = p.number("/stations/camera/camera_height", 0.1, 2.0);
-  layout_.colour_chart = {p.vec2("/stations/camera/colour_chart/position"), p.vec2("/stations/camera/colour_chart/size")};
-  layout_.scale_bar = {p.vec2("/stations/camera/scale_bar/position"), p.vec2("/stations/camera/scale_bar/size")};
-  layout_.stand = {p.vec2("/stations/camera/stand/position"), p.vec2("/stations/camera/stand/size")};
-  layout_.stand_height = p.number("/stations/camera/stand/height", layout_.camera_height, 3.0);
-  layout_.discard = {p.vec2("/stations/discard/position"), p.vec2("/stations/discard/size")};
-  layout_.discard_wall_height = p.number("/stations/discard/wall_height", 0.0, 0.3);
-  layout_.table_colour = p.colour("/simulator/table_colour");
-  layout_.mat_colour = p.colour("/simulator/mat_colour");
-  const auto sc = p.colours("/simulator/scale_colours", 2);
-  layout_.scale_colours = {sc[0], sc[1]};
-
-  scenario_path_ = resolve(workspace_, p.text("/simulator/scenario"));
-  real_time_factor_ = p.number("/simulator/real_time_factor", 0.0, 0.0, 100.0);
-  options_.physics_dt = p.number("/simulator/physics_step", 0.001, 0.0002, 0.002);
-  clock_period_ = p.number("/simulator/clock_period", 0.005, options_.physics_dt, 0.1);
-  joint_state_period_ = p.number("/simulator/joint_state_period", 0.01, options_.physics_dt, 0.01);
-  options_.wrist_camera = p.flag("/simulator/wrist_camera", true);
-  options_.wrist_rate = p.number("/simulator/wrist_rate", 30.0, 1.0, 30.0);
-  point_cloud_ = p.flag("/simulator/point_cloud", true);
-  const auto& lo = ArmKinematics::lowerLimits();
-  const auto& hi = ArmKinematics::upperLimits();
-  const auto q = p.list("/simulator/initial_joints", 6, -3.15, 3.15, {0.0, -1.80, 1.55, 0.0, 0.8, 0.0});
-  for (int j = 0; j < kArmJoints; ++j) {
-    if (q[j] < lo[j] || q[j] > hi[j]) {
-      throw ParamError("parameter /simulator/initial_joints: " + ArmKinematics::jointNames()[j] +
-                       " outside its joint limits");
-    }
-    options_.initial_joints[j] = q[j];
-  }
-  options_.initial_finger = p.number("/simulator/initial_finger", 0.037, ArmKinematics::kFingerMin,
-                                     ArmKinematics::kFingerMax);
-  const auto size = p.list("/simulator/archival_size", 2, 2.0, 8000.0, {2000.0, 1500.0});
-  options_.archival_width = static_cast<int>(size[0]);
-  options_.archival_height = static_cast<int>(size[1]);
-  if (options_.archival_width < 2000 || options_.archival_height < 1500) {
-    throw ParamError("parameter /simulator/archival_size: at least [2000, 1500] px");
-  }
-  spool_dir_ = resolve(workspace_, p.text("/simulator/spool_dir", "var/archival_spool"));
+  config_ = SimParameters::read(rascal_workcell::parametersFromServer("sim"),
+                                rascal_workcell::GripperGeometry::fromPackageUrdf(), pkg + "/data");
+  scenario_path_ = resolve(workspace_, config_.scenario);
+  spool_dir_ = resolve(workspace_, config_.spool_dir);
 }
 
 bool SimNode::cameraWanted() const {
@@ -153,11 +113,11 @@ void SimNode::run() {
       t = sim_->time();
       if (t >= next_clock - 1e-9) {
         clock = true;
-        while (next_clock <= t + 1e-9) next_clock += clock_period_;
+        while (next_clock <= t + 1e-9) next_clock += config_.clock_period;
       }
       if (t >= next_joints - 1e-9) {
         joints = true;
-        while (next_joints <= t + 1e-9) next_joints += joint_state_period_;
+        while (next_joints <= t + 1e-9) next_joints += config_.joint_state_period;
         js.header.stamp = ros::Time(t);
         js.name.assign(names.begin(), names.end());
         js.name.push_back("left_finger");
@@ -197,8 +157,8 @@ void SimNode::run() {
       scale_pub_.publish(m);
     }
     if (frame_ready) publishWristFrame(frame);
-    if (real_time_factor_ > 0.0) {
-      const ros::WallTime due = wall0 + ros::WallDuration((t - sim0) / real_time_factor_);
+    if (config_.real_time_factor > 0.0) {
+      const ros::WallTime due = wall0 + ros::WallDuration((t - sim0) / config_.real_time_factor);
       const ros::WallDuration ahead = due - ros::WallTime::now();
       if (ahead.toSec() > 0.001) ahead.sleep();
     }
@@ -215,7 +175,7 @@ void SimNode::publishWristFrame(const WristFrame& f) {
   const sensor_msgs::CameraInfo info = conversions::toCameraInfo(cam, kOpticalFrame, stamp);
   colour_info_pub_.publish(info);
   depth_info_pub_.publish(info);
-  if (point_cloud_ && cloud_pub_.getNumSubscribers() > 0) {
+  if (config_.point_cloud && cloud_pub_.getNumSubscribers() > 0) {
     cloud_pub_.publish(conversions::toPointCloud(f.depth_mm, f.rgb, cam, kOpticalFrame, stamp));
   }
 }
@@ -335,7 +295,7 @@ bool SimNode::onGroundTruth(rascal_msgs::GetGroundTruth::Request&, rascal_msgs::
 
 bool SimNode::onSpawn(rascal_msgs::SpawnScenario::Request& req, rascal_msgs::SpawnScenario::Response& res) {
   try {
-    ScenarioLoader loader(layout_, *munsell_);
+    ScenarioLoader loader(config_.layout, *munsell_);
     const Scenario s = req.scenario_file.empty() ? loader.parse(req.scenario_yaml)
                                                  : loader.load(resolve(workspace_, req.scenario_file));
     std::lock_guard<std::mutex> lk(mutex_);

@@ -15,19 +15,21 @@
 #include <string>
 
 #include "rascal_sim/MunsellTable.hpp"
+#include "rascal_sim/SimParameters.hpp"
 #include "rascal_sim/Simulator.hpp"
 
 namespace rascal_sim {
 
 class SimNode {
  public:
-  /// Reads and checks the parameters (throws ParamError naming the key), then advertises.
+  /// Reads and checks the parameters (throws rascal_workcell::ParameterError naming the key),
+  /// then advertises.
   explicit SimNode(ros::NodeHandle& nh);
   /// Steps the world until shutdown, publishing clock, joint states, images and scale readings.
   void run();
 
  private:
-  void readParameters(ros::NodeHandle& nh);
+  void readParameters();
   void onArmTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg);
   void onGripperCommand(const trajectory_msgs::JointTrajectory::ConstPtr& msg);
   bool onTare(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
@@ -42,11 +44,8 @@ class SimNode {
   void publishWristFrame(const WristFrame& frame);
 
   // parameters
-  WorldLayout layout_;
-  SimulatorOptions options_;
-  std::string scenario_path_, workspace_, spool_dir_;
-  double real_time_factor_ = 0.0, clock_period_ = 0.001, joint_state_period_ = 0.01;
-  bool point_cloud_ = true;
+  SimParameters config_;
+  std::string scenario_path_, workspace_, spool_dir_;  ///< resolved against the workspace root
 
   std::unique_ptr<MunsellTable> munsell_;
   std::unique_ptr<Simulator> sim_;

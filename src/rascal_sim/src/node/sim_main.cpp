@@ -1,7 +1,6 @@
 // rosrun rascal_sim sim: the simulated WidowX 250 s, wrist D435, archival camera and scale.
 #include <ros/ros.h>
 
-#include "ParamReader.hpp"
 #include "SimNode.hpp"
 
 int main(int argc, char** argv) {

@@ -1,5 +1,6 @@
 // Real-time factor of the simulator core on this machine: 10 sherds, the arm moving between
 // stations, wrist camera off and then rendering at 30 Hz (no ROS; the node adds message costs).
+// The layout and options are the shipped config/rascal.yaml's.
 //   sim_speed [scenario.yaml] [sim_seconds]
 #include <chrono>
 #include <cmath>
@@ -8,16 +9,18 @@
 
 #include "rascal_sim/MunsellTable.hpp"
 #include "rascal_sim/ScenarioLoader.hpp"
+#include "rascal_sim/SimParameters.hpp"
 #include "rascal_sim/Simulator.hpp"
 
 using namespace rascal_sim;
 
 namespace {
-double run(const WorldLayout& layout, const Scenario& scenario, bool camera, double seconds, int& frames,
+double run(const SimParameters& config, const Scenario& scenario, bool camera, double seconds, int& frames,
            double& render_ms) {
-  SimulatorOptions o;
+  SimulatorOptions o = config.options;
   o.wrist_camera = camera;
-  Simulator sim(layout, o);
+  o.wrist_rate = 30.0;
+  Simulator sim(config.layout, o);
   sim.load(scenario);
   // a move every 2 s between a pose over the pickup mat and one over the scale
   const JointVector a{0.9, 0.2, 0.3, 0.0, 1.0, 0.0}, b{0.0, 0.3, 0.2, 0.0, 1.0, 0.0};
@@ -48,20 +51,26 @@ double run(const WorldLayout& layout, const Scenario& scenario, bool camera, dou
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string data = RASCAL_SIM_DATA_DIR;
-  const std::string path = argc > 1 ? argv[1] : data + "/../../../config/scenarios/demo_10.yaml";
-  const double seconds = argc > 2 ? std::stod(argv[2]) : 20.0;
-  const WorldLayout layout = WorldLayout::defaults(data);
-  const MunsellTable munsell(data + "/munsell_soil_hues_grid_renotation.csv");
-  const Scenario scenario = ScenarioLoader(layout, munsell).load(path);
-  int frames = 0;
-  double render_ms = 0.0;
-  const double off = run(layout, scenario, false, seconds, frames, render_ms);
-  std::printf("scenario %s: %zu sherds, %.0f s simulated, 1 ms physics step\n", scenario.name.c_str(),
-              scenario.sherds.size(), seconds);
-  std::printf("core, wrist camera off:          real-time factor %.1fx\n", off);
-  const double on = run(layout, scenario, true, seconds, frames, render_ms);
-  std::printf("core, wrist camera 30 Hz RGB-D:  real-time factor %.1fx (%d frames, %.1f ms per frame)\n", on,
-              frames, render_ms);
+  try {
+    const std::string data = RASCAL_SIM_DATA_DIR;
+    const std::string path = argc > 1 ? argv[1] : data + "/../../../config/scenarios/demo_10.yaml";
+    const double seconds = argc > 2 ? std::stod(argv[2]) : 20.0;
+    const SimParameters config = SimParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sim"),
+                                                     rascal_workcell::GripperGeometry::fromPackageUrdf(), data);
+    const MunsellTable munsell(data + "/munsell_soil_hues_grid_renotation.csv");
+    const Scenario scenario = ScenarioLoader(config.layout, munsell).load(path);
+    int frames = 0;
+    double render_ms = 0.0;
+    const double off = run(config, scenario, false, seconds, frames, render_ms);
+    std::printf("scenario %s: %zu sherds, %.0f s simulated, %.0f ms physics step\n", scenario.name.c_str(),
+                scenario.sherds.size(), seconds, 1000.0 * config.options.physics_dt);
+    std::printf("core, wrist camera off:          real-time factor %.1fx\n", off);
+    const double on = run(config, scenario, true, seconds, frames, render_ms);
+    std::printf("core, wrist camera 30 Hz RGB-D:  real-time factor %.1fx (%d frames, %.1f ms per frame)\n", on,
+                frames, render_ms);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sim_speed: %s\n", e.what());
+    return 1;
+  }
   return 0;
 }

@@ -3,8 +3,7 @@
 #include <ros/param.h>
 
 #include <algorithm>
-#include <iomanip>
-#include <sstream>
+#include <charconv>
 
 namespace rascal_workcell {
 
@@ -25,9 +24,10 @@ YAML::Node toYaml(XmlRpc::XmlRpcValue& v) {
     case XmlRpc::XmlRpcValue::TypeBoolean: return YAML::Node(static_cast<bool>(v) ? "true" : "false");
     case XmlRpc::XmlRpcValue::TypeInt: return YAML::Node(static_cast<int>(v));
     case XmlRpc::XmlRpcValue::TypeDouble: {
-      std::ostringstream ss;
-      ss << std::setprecision(17) << static_cast<double>(v);
-      return YAML::Node(ss.str());
+      // The shortest text that reads back as the same double: 0.3, not 0.29999999999999999.
+      char text[32];
+      const auto end = std::to_chars(text, text + sizeof text, static_cast<double>(v)).ptr;
+      return YAML::Node(std::string(text, end));
     }
     case XmlRpc::XmlRpcValue::TypeString: {
       YAML::Node n(static_cast<std::string>(v));
