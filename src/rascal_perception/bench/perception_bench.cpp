@@ -1,7 +1,8 @@
 // Perception speed: median and 99th percentile time per 640 x 480 wrist frame for segmentation
 // alone (SherdDetector::segment: background, fixtures, depth, blobs, splitting) and for a full
-// detect (plus the plane, measurement, grasps, order), on frames rendered by the simulator's
-// core (generated scenes, 6..10 sherds, lighting 0.3 .. 1.5 x). Run it on one core:
+// detect (plus the plane, measurement, grasps, scores), on frames rendered by the simulator's
+// core (generated scenes, 6..10 sherds, lighting 0.3 .. 1.5 x), with the parameters the node
+// reads (the shipped config/rascal.yaml, the URDF's gripper). Run it on one core:
 //   taskset -c 0 perception_bench [frames]
 #include <time.h>
 
@@ -14,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "../test/SimScenes.hpp"
+#include "rascal_perception/DetectorParameters.hpp"
 #include "rascal_perception/SherdDetector.hpp"
 
 using namespace rascal_perception;
@@ -41,6 +43,10 @@ void report(const char* what, std::vector<double> t) {
 int main(int argc, char** argv) {
   const int scenes = argc > 1 ? std::max(1, std::stoi(argv[1])) : 40;
   cv::setNumThreads(1);  // one core: no OpenCV worker threads competing for it
+  const DetectorParameters params =
+      DetectorParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sherd_detector"),
+                               rascal_workcell::GripperGeometry::fromPackageUrdf());
+  const double surface_z = params.workcell.station(rascal_workcell::StationType::Pickup).surface_z;
   const int repeats = 5;
   std::vector<double> seg, det, seg_cpu, det_cpu;
   size_t sherds = 0;
@@ -52,16 +58,16 @@ int main(int argc, char** argv) {
     empty.sherds.clear();
     const Frame cal = render(empty, surveyJoints());
     const Frame f = render(sc, surveyJoints());
-    SherdDetector d{PerceptionConfig()};
-    d.calibrate("pickup", cal.rgb, cal.depth, cal.view, 0.0);
+    SherdDetector d{params.config};
+    d.calibrate("pickup", cal.rgb, cal.depth, cal.view, surface_z);
     cv::Mat fg;
     for (int k = 0; k < repeats; ++k) {
       const double c0 = cpuMs();
       auto t0 = Clock::now();
-      d.segment("pickup", f.rgb, f.depth, f.view, 0.0, fg);
+      d.segment("pickup", f.rgb, f.depth, f.view, surface_z, fg);
       auto t1 = Clock::now();
       const double c1 = cpuMs();
-      const DetectionResult r = d.detect("pickup", f.rgb, f.depth, f.view, 0.0);
+      const DetectionResult r = d.detect("pickup", f.rgb, f.depth, f.view, surface_z);
       auto t2 = Clock::now();
       const double c2 = cpuMs();
       seg.push_back(ms(t1 - t0));

@@ -8,6 +8,7 @@ sherd_detector; moves the arm over the pickup mat, calibrates the empty mat, spa
 sherds, detects, opens rviz (config/detections.rviz) on a virtual display and grabs the screen
 through libX11 (no screenshot tool needed).
 """
+
 import ctypes
 import os
 import signal
@@ -29,12 +30,23 @@ W, H = 1280, 800
 
 
 class XImage(ctypes.Structure):
-    _fields_ = [("width", ctypes.c_int), ("height", ctypes.c_int), ("xoffset", ctypes.c_int),
-                ("format", ctypes.c_int), ("data", ctypes.c_void_p), ("byte_order", ctypes.c_int),
-                ("bitmap_unit", ctypes.c_int), ("bitmap_bit_order", ctypes.c_int),
-                ("bitmap_pad", ctypes.c_int), ("depth", ctypes.c_int), ("bytes_per_line", ctypes.c_int),
-                ("bits_per_pixel", ctypes.c_int), ("red_mask", ctypes.c_ulong),
-                ("green_mask", ctypes.c_ulong), ("blue_mask", ctypes.c_ulong)]
+    _fields_ = [
+        ("width", ctypes.c_int),
+        ("height", ctypes.c_int),
+        ("xoffset", ctypes.c_int),
+        ("format", ctypes.c_int),
+        ("data", ctypes.c_void_p),
+        ("byte_order", ctypes.c_int),
+        ("bitmap_unit", ctypes.c_int),
+        ("bitmap_bit_order", ctypes.c_int),
+        ("bitmap_pad", ctypes.c_int),
+        ("depth", ctypes.c_int),
+        ("bytes_per_line", ctypes.c_int),
+        ("bits_per_pixel", ctypes.c_int),
+        ("red_mask", ctypes.c_ulong),
+        ("green_mask", ctypes.c_ulong),
+        ("blue_mask", ctypes.c_ulong),
+    ]
 
 
 def grab(display):
@@ -43,14 +55,24 @@ def grab(display):
     x11.XDefaultRootWindow.restype = ctypes.c_ulong
     x11.XDefaultRootWindow.argtypes = [ctypes.c_void_p]
     x11.XGetImage.restype = ctypes.POINTER(XImage)
-    x11.XGetImage.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_int, ctypes.c_int, ctypes.c_uint,
-                              ctypes.c_uint, ctypes.c_ulong, ctypes.c_int]
+    x11.XGetImage.argtypes = [
+        ctypes.c_void_p,
+        ctypes.c_ulong,
+        ctypes.c_int,
+        ctypes.c_int,
+        ctypes.c_uint,
+        ctypes.c_uint,
+        ctypes.c_ulong,
+        ctypes.c_int,
+    ]
     d = x11.XOpenDisplay(display.encode())
     if not d:
         raise RuntimeError("cannot open display " + display)
     img = x11.XGetImage(d, x11.XDefaultRootWindow(d), 0, 0, W, H, 0xFFFFFFFF, 2).contents
     raw = ctypes.string_at(img.data, img.bytes_per_line * img.height)
-    a = np.frombuffer(raw, np.uint8).reshape(img.height, img.bytes_per_line // 4, 4)[:, :img.width, :3]
+    a = np.frombuffer(raw, np.uint8).reshape(img.height, img.bytes_per_line // 4, 4)[
+        :, : img.width, :3
+    ]
     return a.copy()
 
 
@@ -61,41 +83,94 @@ def main():
     port = s.getsockname()[1]
     s.close()
     log = tempfile.mkdtemp(prefix="rascal_rviz_")
-    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_HOSTNAME="127.0.0.1",
-               ROS_LOG_DIR=log, ROS_HOME=log, DISPLAY=":97", LIBGL_ALWAYS_SOFTWARE="1")
+    env = dict(
+        os.environ,
+        ROS_MASTER_URI="http://127.0.0.1:%d" % port,
+        ROS_HOSTNAME="127.0.0.1",
+        ROS_LOG_DIR=log,
+        ROS_HOME=log,
+        DISPLAY=":97",
+        LIBGL_ALWAYS_SOFTWARE="1",
+    )
     procs = []
 
     def start(cmd):
-        p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                             start_new_session=True)
+        p = subprocess.Popen(
+            cmd,
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
         procs.append(p)
         return p
 
     def run(cmd):
-        return subprocess.run(cmd, env=env, capture_output=True, text=True, check=True, timeout=120).stdout
+        return subprocess.run(
+            cmd, env=env, capture_output=True, text=True, check=True, timeout=120
+        ).stdout
 
     try:
         start(["roscore", "-p", str(port)])
         start(["Xvfb", ":97", "-screen", "0", "%dx%dx24" % (W, H)])
         for _ in range(100):
-            if subprocess.run(["rosparam", "get", "/run_id"], env=env, capture_output=True).returncode == 0:
+            if (
+                subprocess.run(
+                    ["rosparam", "get", "/run_id"], env=env, capture_output=True
+                ).returncode
+                == 0
+            ):
                 break
             time.sleep(0.2)
         run(["rosparam", "load", os.path.join(WS, "config", "rascal.yaml")])
         run(["rosparam", "set", "/use_sim_time", "true"])
         run(["rosparam", "set", "/simulator/real_time_factor", "1.0"])
-        run(["rosparam", "set", "--textfile", os.path.join(WS, "src", "rascal_description", "urdf", "wx250s.urdf"),
-             "/robot_description"])
+        run(
+            [
+                "rosparam",
+                "set",
+                "--textfile",
+                os.path.join(WS, "src", "rascal_description", "urdf", "wx250s.urdf"),
+                "/robot_description",
+            ]
+        )
         start(["rosrun", "rascal_sim", "sim"])
         start(["rosrun", "robot_state_publisher", "robot_state_publisher"])
         start(["rosrun", "rascal_perception", "sherd_detector"])
         time.sleep(5)  # the nodes come up
-        run(["rosservice", "call", "/sim/spawn", "{scenario_file: '', scenario_yaml: 'name: empty'}"])
+        run(
+            [
+                "rosservice",
+                "call",
+                "/sim/spawn",
+                "{scenario_file: '', scenario_yaml: 'name: empty'}",
+            ]
+        )
         traj = "{joint_names: [%s], points: [{positions: [%s], time_from_start: {secs: 2}}]}" % (
-            ", ".join(ARM), ", ".join(str(q) for q in SURVEY))
-        run(["rostopic", "pub", "-1", "/arm/joint_trajectory", "trajectory_msgs/JointTrajectory", traj])
+            ", ".join(ARM),
+            ", ".join(str(q) for q in SURVEY),
+        )
+        run(
+            [
+                "rostopic",
+                "pub",
+                "-1",
+                "/arm/joint_trajectory",
+                "trajectory_msgs/JointTrajectory",
+                traj,
+            ]
+        )
         time.sleep(4)
-        print(run(["rosservice", "call", "/rascal/perception/calibrate_background", "{station: pickup}"]))
+        print(
+            run(
+                [
+                    "rosservice",
+                    "call",
+                    "/rascal/perception/calibrate_background",
+                    "{station: pickup}",
+                ]
+            )
+        )
         demo = os.path.join(WS, "config", "scenarios", "demo_10.yaml")
         run(["rosservice", "call", "/sim/spawn", "{scenario_file: '%s', scenario_yaml: ''}" % demo])
         time.sleep(1)

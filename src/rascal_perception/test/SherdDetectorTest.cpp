@@ -12,14 +12,24 @@
 
 #include "SimScenes.hpp"
 #include "rascal_perception/Annotator.hpp"
+#include "rascal_perception/DetectorParameters.hpp"
 #include "rascal_perception/SherdDetector.hpp"
 
 using namespace rascal_perception;
 using namespace rascal_perception_test;
+using rascal_workcell::StationType;
 
 namespace {
 
-PerceptionConfig config() { return PerceptionConfig(); }  // the defaults are config/rascal.yaml's
+/// What the node reads: the shipped config/rascal.yaml and the package URDF's gripper.
+const DetectorParameters& shipped() {
+  static const DetectorParameters p =
+      DetectorParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sherd_detector"),
+                               rascal_workcell::GripperGeometry::fromPackageUrdf());
+  return p;
+}
+const PerceptionConfig& config() { return shipped().config; }
+double pickupZ() { return shipped().workcell.station(StationType::Pickup).surface_z; }
 
 rascal_sim::Scenario emptyLike(const rascal_sim::Scenario& s) {
   rascal_sim::Scenario e = s;
@@ -122,9 +132,9 @@ void save(const std::string& name, const Frame& f, const DetectionResult& r) {
 DetectionResult calibrateAndDetect(const rascal_sim::Scenario& sc, const Frame& f, SherdDetector& d,
                                    const rascal_sim::Scenario* calib = nullptr) {
   const Frame empty = render(emptyLike(calib ? *calib : sc), surveyJoints());
-  const CalibrationResult c = d.calibrate("pickup", empty.rgb, empty.depth, empty.view, 0.0);
+  const CalibrationResult c = d.calibrate("pickup", empty.rgb, empty.depth, empty.view, pickupZ());
   EXPECT_TRUE(c.success) << c.message;
-  return d.detect("pickup", f.rgb, f.depth, f.view, 0.0);
+  return d.detect("pickup", f.rgb, f.depth, f.view, pickupZ());
 }
 
 }  // namespace
@@ -141,11 +151,31 @@ TEST(SherdDetector, FindsTheDemoScenarioSherds) {
   EXPECT_GE(t.expected, 6);
   EXPECT_EQ(t.found, t.expected);
   EXPECT_EQ(t.false_positives, 0);
-  for (const SherdDetection& s : r.sherds) {
-    EXPECT_GE(s.grasp_width, 0.030);
-    EXPECT_LE(s.grasp_width, 0.074);
-    const PerceptionConfig defaults;
-    EXPECT_GE(s.grasp.translation().z() - s.surface, defaults.grasp_tip_clearance + defaults.fingertip_offset - 1e-9);
+  const PerceptionConfig& c = config();
+  for (size_t i = 0; i < r.sherds.size(); ++i) {
+    const SherdDetection& s = r.sherds[i];
+    EXPECT_GE(s.grasp_width, c.gripper.minOpening());
+    EXPECT_LE(s.grasp_width, c.gripper.maxOpening());
+    EXPECT_GE(s.grasp.translation().z() - s.surface, c.grasp_tip_clearance + c.gripper.fingertip_offset - 1e-9);
+    if (i > 0) {
+      EXPECT_GE(r.sherds[i - 1].score, s.score) << "detections are ordered by score, best first";
+    }
+  }
+}
+
+TEST(SherdDetector, SameFrameSameOrder) {
+  // the order is the detector's documented one (score, then segmentation order), frame by frame
+  const rascal_sim::Scenario sc = generated(7, 9, 1.0, 5600, 0.2);
+  const Frame f = render(sc, surveyJoints());
+  SherdDetector d(config());
+  const DetectionResult a = calibrateAndDetect(sc, f, d);
+  const DetectionResult b = d.detect("pickup", f.rgb, f.depth, f.view, pickupZ());
+  ASSERT_EQ(a.sherds.size(), b.sherds.size());
+  for (size_t i = 0; i < a.sherds.size(); ++i) {
+    EXPECT_EQ(a.sherds[i].centre, b.sherds[i].centre) << i;
+    if (i > 0) {
+      EXPECT_GE(a.sherds[i - 1].score, a.sherds[i].score) << i;
+    }
   }
 }
 
@@ -245,9 +275,9 @@ TEST(SherdDetector, BackgroundCalibratedInDimLightWorksInBrightLight) {
       EXPECT_EQ(t.found, t.expected);
       EXPECT_EQ(t.false_positives, 0);
       // the colours re-learnt from this frame (sherds left out) still find them all
-      ASSERT_TRUE(d.refresh("pickup", f.rgb, f.depth, f.view, 0.0).success);
+      ASSERT_TRUE(d.refresh("pickup", f.rgb, f.depth, f.view, pickupZ()).success);
       Tally after;
-      score(f, d.detect("pickup", f.rgb, f.depth, f.view, 0.0), after, "refreshed, seed " + std::to_string(seed));
+      score(f, d.detect("pickup", f.rgb, f.depth, f.view, pickupZ()), after, "refreshed, seed " + std::to_string(seed));
       EXPECT_EQ(after.found, after.expected);
       EXPECT_EQ(after.false_positives, 0);
     }
@@ -261,8 +291,10 @@ TEST(SherdDetector, OneSherdOnTheScaleAndAtTheCameraStation) {
     Eigen::Vector2d where;
     double surface;
   };
-  for (const Case& c : {Case{"scale", layout().scale.position, layout().scale_surface_z},
-                        Case{"camera", layout().camera_place_at, 0.0}}) {
+  const rascal_workcell::Station& scale = station(StationType::Scale);
+  const rascal_workcell::Station& camera = station(StationType::ArchivalCamera);
+  for (const Case& c : {Case{scale.name, scale.area.centre, scale.surface_z},
+                        Case{camera.name, camera.place_at, camera.surface_z}}) {
     rascal_sim::Scenario sc = base;
     sc.sherds[0].pose = Eigen::Vector3d(c.where.x(), c.where.y(), 0.4);
     rascal_sim::Scenario empty = sc;
@@ -296,11 +328,11 @@ TEST(SherdDetector, PickupCalibratedOnTheEmptyDiscardMat) {
     const rascal_sim::Scenario sc = generated(seed, 8, 0.4 + 0.1 * (seed - 401), 5600, 0.3);
     rascal_sim::Scenario empty = sc;
     empty.sherds.clear();
-    const Frame cal = render(empty, cameraOver(layout().discard.position));
+    const Frame cal = render(empty, cameraOver(station(StationType::Discard).area.centre));
     const Frame f = render(sc, surveyJoints());
     SherdDetector d(config());
-    ASSERT_TRUE(d.calibrate("pickup", cal.rgb, cal.depth, cal.view, 0.0).success);
-    const DetectionResult r = d.detect("pickup", f.rgb, f.depth, f.view, 0.0);
+    ASSERT_TRUE(d.calibrate("pickup", cal.rgb, cal.depth, cal.view, pickupZ()).success);
+    const DetectionResult r = d.detect("pickup", f.rgb, f.depth, f.view, pickupZ());
     if (seed == 401) save("pickup_from_discard", f, r);
     score(f, r, t, "discard-calibrated seed " + std::to_string(seed));
   }

@@ -15,10 +15,20 @@ using namespace rascal_sim;
 
 namespace rascal_perception_test {
 
-const WorldLayout& layout() {
-  static const WorldLayout l = WorldLayout::defaults(RASCAL_SIM_DATA_DIR);
-  return l;
+const SimParameters& simParameters() {
+  static const SimParameters p =
+      SimParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sim"),
+                          rascal_workcell::GripperGeometry::fromPackageUrdf(), RASCAL_SIM_DATA_DIR);
+  return p;
 }
+
+const WorldLayout& layout() { return simParameters().layout; }
+
+const rascal_workcell::Station& station(rascal_workcell::StationType type) { return layout().station(type); }
+
+namespace {
+double fingersOpen() { return simParameters().options.gripper.finger_max; }
+}  // namespace
 
 static const MunsellTable& munsell() {
   static const MunsellTable m(std::string(RASCAL_SIM_DATA_DIR) + "/munsell_soil_hues_grid_renotation.csv");
@@ -34,7 +44,7 @@ JointVector pointDown(double x, double y, double z) {
       for (double el = el0; el <= el1; el += step) {
         const JointVector q{waist, sh, el, 0, M_PI / 2 - sh - el, 0};
         if (q[4] < ArmKinematics::lowerLimits()[4] || q[4] > ArmKinematics::upperLimits()[4]) continue;
-        const Eigen::Vector3d p = ArmKinematics::forward(q, 0.037)[kEeGripperLink].translation();
+        const Eigen::Vector3d p = ArmKinematics::forward(q, fingersOpen())[kEeGripperLink].translation();
         const double err = std::hypot(std::hypot(p.x(), p.y()) - r, p.z() - z);
         if (err < best_err) {
           best_err = err;
@@ -56,14 +66,14 @@ JointVector cameraOver(const Eigen::Vector2d& goal, double ee_z) {
   for (int i = 0; i < 3; ++i) {
     j = pointDown(target.x(), target.y(), ee_z);
     j[5] = -j[0];
-    const auto T = ArmKinematics::forward(j, 0.037);
+    const auto T = ArmKinematics::forward(j, fingersOpen());
     target += goal - T[kCameraColorOpticalFrame].translation().head<2>();
   }
   return j;
 }
 
 const JointVector& surveyJoints() {
-  static const JointVector q = cameraOver(layout().pickup.position);
+  static const JointVector q = cameraOver(station(StationType::Pickup).area.centre);
   return q;
 }
 
@@ -72,7 +82,7 @@ Frame render(const Scenario& scenario, const JointVector& q) {
   static std::map<JointVector, std::unique_ptr<Simulator>> cache;
   std::unique_ptr<Simulator>& cached = cache[q];
   if (!cached) {
-    SimulatorOptions o;
+    SimulatorOptions o = simParameters().options;
     o.initial_joints = q;
     o.archival_width = 64;
     o.archival_height = 48;
@@ -130,11 +140,11 @@ Scenario generated(unsigned seed, int count, double brightness, double kelvin, d
   sc.lighting.colour_temperature = kelvin;
   sc.lighting.shadow_strength = shadow;
   sc.lighting.shadow_radius = 0.07;
-  sc.lighting.shadow_start = layout().pickup.position + Eigen::Vector2d(0.02 * (seed % 5) - 0.04, 0.0);
+  sc.lighting.shadow_start = station(StationType::Pickup).area.centre + Eigen::Vector2d(0.02 * (seed % 5) - 0.04, 0.0);
   GeneratorOptions g;
   g.count = count;
   g.seed = seed;
-  g.area = layout().pickup;
+  g.area = station(StationType::Pickup).area;
   g.touching_pairs = touching_pairs;
   sc.sherds = ScenarioGenerator(munsell()).generate(g);
   return sc;

@@ -8,6 +8,7 @@
 #include "rascal_perception/SherdMeasurer.hpp"
 #include "rascal_sim/ArmKinematics.hpp"
 #include "rascal_sim/Scenario.hpp"
+#include "rascal_sim/SimParameters.hpp"
 #include "rascal_sim/WorldLayout.hpp"
 
 namespace rascal_perception_test {
@@ -28,7 +29,11 @@ struct Frame {
   std::vector<Truth> truth;
 };
 
+/// The simulator as the shipped config/rascal.yaml and the URDF set it up (read once).
+const rascal_sim::SimParameters& simParameters();
 const rascal_sim::WorldLayout& layout();
+/// A station of the shipped workcell by type (its area, surface_z, place_at).
+const rascal_workcell::Station& station(rascal_workcell::StationType type);
 /// Joints putting ee_gripper_link at (x, y, z) pointing straight down.
 rascal_sim::JointVector pointDown(double x, double y, double z);
 /// Joints putting the wrist camera over `goal` (x, y), image rows along base_link x.

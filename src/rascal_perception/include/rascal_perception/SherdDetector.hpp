@@ -1,6 +1,6 @@
 #pragma once
 // The whole pipeline per station: calibrate a background model on the empty station, then detect
-// sherds (segment -> separate -> measure -> grasp -> order). The calibration view is carried to a
+// sherds (segment -> separate -> measure -> grasp -> score). The calibration view is carried to a
 // later camera pose through the homography of the station plane, so the survey may move.
 #include <map>
 #include <string>
@@ -23,6 +23,7 @@ struct CalibrationResult {
 
 class SherdDetector {
  public:
+  /// Throws std::invalid_argument when config.gripper is unset (see GraspPlanner).
   explicit SherdDetector(const PerceptionConfig& config);
   /// Learns `station`'s background from an image of it empty. `depth_mm` may be empty.
   CalibrationResult calibrate(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
@@ -30,7 +31,8 @@ class SherdDetector {
   /// Re-learns the station's colours from a frame with sherds in it (the sherds left out).
   CalibrationResult refresh(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
                             const CameraView& view, double surface_z);
-  /// Sherds in base_link, ordered by the selection policy. `depth_mm` may be empty (no heights).
+  /// Sherds in base_link, best score first (ties in segmentation order: deterministic for a given
+  /// frame); the task layer chooses which to pick. `depth_mm` may be empty (no heights).
   DetectionResult detect(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
                          const CameraView& view, double surface_z);
   /// Segmentation only: the blobs and the foreground mask (for benches and the annotated image).
@@ -40,7 +42,6 @@ class SherdDetector {
   bool calibrated(const std::string& station) const { return stations_.count(station) > 0; }
   const BackgroundModel* model(const std::string& station) const;
   const PerceptionConfig& config() const { return config_; }
-  void setSelectionPolicy(SelectionPolicy policy) { config_.selection_policy = policy; }
 
  private:
   struct Station {

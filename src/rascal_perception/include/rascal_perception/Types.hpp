@@ -1,10 +1,12 @@
 #pragma once
 // Value types shared by the perception core: camera intrinsics, the configuration (perception.*
-// of config/rascal.yaml), segmented blobs and measured sherds. No ROS.
+// of config/rascal.yaml, the gripper from the URDF), segmented blobs and measured sherds. No ROS.
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
+
+#include "rascal_workcell/GripperGeometry.hpp"
 
 namespace rascal_perception {
 
@@ -19,11 +21,8 @@ struct CameraIntrinsics {
   }
 };
 
-enum class SelectionPolicy { kNearest, kLargest, kMostIsolated };
-/// "nearest" | "largest" | "most_isolated"; throws std::invalid_argument otherwise.
-SelectionPolicy parseSelectionPolicy(const std::string& name);
-
-/// perception.* of config/rascal.yaml (+ arm.grasp_margin). Lengths in metres.
+/// perception.* of config/rascal.yaml (+ arm.grasp_margin; DetectorParameters::read fills it
+/// through the parameter schema) and the gripper from the URDF. Lengths in metres.
 struct PerceptionConfig {
   int background_clusters = 3;
   double hue_tolerance = 0.15;         ///< half-width of a cluster's hue band, fraction of the hue circle
@@ -33,12 +32,13 @@ struct PerceptionConfig {
   double min_sherd_size = 0.015;       ///< [m] shortest side of the smallest sherd
   double max_sherd_size = 0.12;        ///< [m] longest side of the largest sherd
   int border_margin = 3;               ///< [px] blobs this close to the border are cut off
-  SelectionPolicy selection_policy = SelectionPolicy::kNearest;
   double depth_min = 0.15, depth_max = 1.0;  ///< [m] depth outside is ignored
   double grasp_margin = 0.012;         ///< [m] arm.grasp_margin: opening beyond the measured width
   double grasp_height_fraction = 0.6;  ///< fingertips close at this fraction of the measured height
   double grasp_tip_clearance = 0.0025; ///< [m] fingertips never lower than this above the surface (facts: the paper's clearance)
-  double fingertip_offset = 0.0044;    ///< [m] fingertips below ee_gripper_link (finger box end)
+  /// Finger limits (the opening clamp) and fingertip offset below ee_gripper_link, from the URDF
+  /// (rascal_workcell::GripperGeometry); GraspPlanner refuses it unset.
+  rascal_workcell::GripperGeometry gripper;
   double split_min_neck = 0.75;        ///< touching sherds split where the neck < this x the smaller peak
   double plane_tolerance = 0.003;      ///< [m] RANSAC inlier distance of the table plane
   double min_sherd_height = 0.0025;    ///< [m] depth this far above the surface is sherd, whatever its colour
@@ -61,7 +61,7 @@ struct SherdDetection {
   double surface = 0.0;        ///< [m] z of the station surface (fitted plane) under the centre
   Eigen::Vector3d colour = Eigen::Vector3d::Zero();  ///< mean sRGB [0, 1]
   Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();  ///< ee_gripper_link target
-  double grasp_width = 0.0;    ///< [m] opening before closing, 0.030 .. 0.074
+  double grasp_width = 0.0;    ///< [m] opening before closing, within the gripper's (30 .. 74 mm)
   double score = 0.0;          ///< [1] in [0, 1]
   double clearance = 1.0;      ///< [m] gap to the nearest other sherd (1 = alone)
   bool depth_valid = false;    ///< false: measured without depth (height unknown = 0)
@@ -70,7 +70,8 @@ struct SherdDetection {
   std::vector<cv::Point> contour;        ///< image contour (for drawing)
 };
 
-/// Result of a detection: the sherds ordered by the selection policy, or why there are none.
+/// Result of a detection: the sherds by score, best first (ties in segmentation order), or why
+/// there are none. Which sherd is picked is the task layer's choice (perception.selection_policy).
 struct DetectionResult {
   bool success = false;
   std::string message;

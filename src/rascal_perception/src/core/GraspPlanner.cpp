@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace rascal_perception {
 
@@ -26,13 +27,22 @@ double outlineGap(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen
 }
 }  // namespace
 
+GraspPlanner::GraspPlanner(const PerceptionConfig& config) : config_(config) {
+  const rascal_workcell::GripperGeometry& g = config_.gripper;
+  if (!(g.minOpening() > 0.0 && g.maxOpening() > g.minOpening())) {
+    throw std::invalid_argument(
+        "GraspPlanner: PerceptionConfig::gripper has no finger limits; fill it from the URDF "
+        "(rascal_workcell::GripperGeometry::fromUrdf or fromPackageUrdf)");
+  }
+}
+
 void GraspPlanner::plan(SherdDetection& s) const {
   const double tip = std::max(config_.grasp_height_fraction * s.height, config_.grasp_tip_clearance);
   s.grasp = Eigen::Isometry3d::Identity();
   s.grasp.linear() = (Eigen::AngleAxisd(s.yaw, Eigen::Vector3d::UnitZ()) *
                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY())).toRotationMatrix();
-  s.grasp.translation() = Eigen::Vector3d(s.centre.x(), s.centre.y(), s.surface + tip + config_.fingertip_offset);
-  s.grasp_width = std::clamp(s.width + config_.grasp_margin, kMinOpening, kMaxOpening);
+  s.grasp.translation() = Eigen::Vector3d(s.centre.x(), s.centre.y(), s.surface + tip + config_.gripper.fingertip_offset);
+  s.grasp_width = std::clamp(s.width + config_.grasp_margin, minOpening(), maxOpening());
 }
 
 void GraspPlanner::score(std::vector<SherdDetection>& sherds) const {
@@ -46,7 +56,7 @@ void GraspPlanner::score(std::vector<SherdDetection>& sherds) const {
     SherdDetection& s = sherds[i];
     s.clearance = gap;
     const double isolation = std::clamp(gap / kFingerWidth, 0.0, 1.0);
-    const double fit = s.width + config_.grasp_margin <= kMaxOpening ? 1.0 : 0.3;
+    const double fit = s.width + config_.grasp_margin <= maxOpening() ? 1.0 : 0.3;
     const double depth = s.depth_valid ? 1.0 : 0.5;
     s.score = fit * depth * (0.5 + 0.5 * isolation);
   }

@@ -1,10 +1,9 @@
 #include "rascal_perception/SherdDetector.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <opencv2/imgproc.hpp>
-
-#include "rascal_perception/SherdSelector.hpp"
 
 namespace rascal_perception {
 
@@ -205,7 +204,9 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
     r.sherds.push_back(std::move(d));
   }
   planner_.score(r.sherds);
-  SherdSelector::order(r.sherds, config_.selection_policy, view.base_T_camera.translation().head<2>());
+  // best score first, ties in segmentation order; which sherd is picked is the task layer's choice
+  std::stable_sort(r.sherds.begin(), r.sherds.end(),
+                   [](const SherdDetection& a, const SherdDetection& b) { return a.score > b.score; });
   r.success = true;
   r.message = "station " + station + ": " + std::to_string(r.sherds.size()) + " sherds";
   return r;

@@ -1,57 +1,51 @@
 #include "Conversions.hpp"
 
-#include <cmath>
+#include <cv_bridge/cv_bridge.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <algorithm>
 #include <cstdio>
-#include <cstring>
-#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 namespace rascal_perception {
 namespace conversions {
 
-namespace {
-cv::Mat wrap(const sensor_msgs::Image& msg, int type, size_t pixel_bytes) {
-  if (msg.step < msg.width * pixel_bytes || msg.data.size() < static_cast<size_t>(msg.step) * msg.height) {
-    throw std::invalid_argument("image data shorter than width x height");
-  }
-  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
-                 const_cast<uint8_t*>(msg.data.data()), msg.step);
-}
-}  // namespace
+namespace enc = sensor_msgs::image_encodings;
 
 cv::Mat colourImage(const sensor_msgs::Image& msg) {
-  cv::Mat out;
-  if (msg.encoding == "rgb8") {
-    wrap(msg, CV_8UC3, 3).copyTo(out);
-  } else if (msg.encoding == "bgr8") {
-    cv::cvtColor(wrap(msg, CV_8UC3, 3), out, cv::COLOR_BGR2RGB);
-  } else {
+  if (msg.encoding != enc::RGB8 && msg.encoding != enc::BGR8) {
     throw std::invalid_argument("colour encoding '" + msg.encoding + "' (need rgb8 or bgr8)");
   }
-  return out;
+  try {
+    return cv_bridge::toCvCopy(msg, enc::RGB8)->image;  // bgr8 is converted
+  } catch (const cv_bridge::Exception& e) {
+    throw std::invalid_argument("malformed " + msg.encoding + " image: " + e.what());
+  }
 }
 
 cv::Mat depthImage(const sensor_msgs::Image& msg) {
-  cv::Mat out;
-  if (msg.encoding == "16UC1" || msg.encoding == "mono16") {
-    wrap(msg, CV_16UC1, 2).copyTo(out);
-  } else if (msg.encoding == "32FC1") {
-    wrap(msg, CV_32FC1, 4).convertTo(out, CV_16UC1, 1000.0);
-  } else {
+  const bool mm = msg.encoding == enc::TYPE_16UC1 || msg.encoding == enc::MONO16;
+  if (!mm && msg.encoding != enc::TYPE_32FC1) {
     throw std::invalid_argument("depth encoding '" + msg.encoding + "' (need 16UC1 mm or 32FC1 m)");
+  }
+  cv_bridge::CvImageConstPtr in;
+  try {
+    in = cv_bridge::toCvShare(msg, nullptr);  // the message's pixels, size-checked, not copied
+  } catch (const cv_bridge::Exception& e) {
+    throw std::invalid_argument("malformed " + msg.encoding + " image: " + e.what());
+  }
+  cv::Mat out;
+  if (mm) {
+    in->image.copyTo(out);
+  } else {
+    in->image.convertTo(out, CV_16UC1, 1000.0);  // metres -> millimetres, rounded, saturated
   }
   return out;
 }
 
 sensor_msgs::Image toImage(const cv::Mat& rgb, const std_msgs::Header& header) {
   sensor_msgs::Image m;
-  m.header = header;
-  m.height = rgb.rows;
-  m.width = rgb.cols;
-  m.encoding = "rgb8";
-  m.step = rgb.cols * 3;
-  m.data.resize(static_cast<size_t>(m.step) * m.height);
-  for (int y = 0; y < rgb.rows; ++y) std::memcpy(&m.data[static_cast<size_t>(y) * m.step], rgb.ptr(y), m.step);
+  cv_bridge::CvImage(header, enc::RGB8, rgb).toImageMsg(m);
   return m;
 }
 
@@ -67,26 +61,6 @@ CameraIntrinsics intrinsics(const sensor_msgs::CameraInfo& info) {
   return k;
 }
 
-Eigen::Isometry3d toEigen(const geometry_msgs::Transform& t) {
-  Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-  e.translation() = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
-  e.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).normalized().toRotationMatrix();
-  return e;
-}
-
-geometry_msgs::Pose toPose(const Eigen::Isometry3d& pose) {
-  geometry_msgs::Pose p;
-  p.position.x = pose.translation().x();
-  p.position.y = pose.translation().y();
-  p.position.z = pose.translation().z();
-  const Eigen::Quaterniond q(pose.linear());
-  p.orientation.w = q.w();
-  p.orientation.x = q.x();
-  p.orientation.y = q.y();
-  p.orientation.z = q.z();
-  return p;
-}
-
 rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& header, uint32_t id) {
   rascal_msgs::Sherd s;
   s.header = header;
@@ -94,7 +68,7 @@ rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& head
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() = d.centre;
   pose.linear() = Eigen::AngleAxisd(d.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  s.pose = toPose(pose);
+  s.pose = tf2::toMsg(pose);
   s.length = d.length;
   s.width = d.width;
   s.height = d.height;
@@ -103,17 +77,11 @@ rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& head
   s.color.g = static_cast<float>(d.colour.y());
   s.color.b = static_cast<float>(d.colour.z());
   s.color.a = 1.0f;
-  s.grasp_pose = toPose(d.grasp);
+  s.grasp_pose = tf2::toMsg(d.grasp);
   s.grasp_width = d.grasp_width;
   s.score = d.score;
   for (int i = 0; i < 5; ++i) s.image_box[i] = d.image_box[i];
-  for (const Eigen::Vector3d& p : d.outline) {
-    geometry_msgs::Point q;
-    q.x = p.x();
-    q.y = p.y();
-    q.z = p.z();
-    s.outline.push_back(q);
-  }
+  for (const Eigen::Vector3d& p : d.outline) s.outline.push_back(tf2::toMsg(p));
   return s;
 }
 
@@ -135,7 +103,7 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
     const double h = std::max(d.height, 0.002);
     pose.translation() = Eigen::Vector3d(d.centre.x(), d.centre.y(), d.surface + 0.5 * h);
     pose.linear() = Eigen::AngleAxisd(d.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    box.pose = toPose(pose);
+    box.pose = tf2::toMsg(pose);
     box.scale.x = d.length;
     box.scale.y = d.width;
     box.scale.z = h;
@@ -150,11 +118,8 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
     arrow.type = visualization_msgs::Marker::ARROW;
     arrow.pose = geometry_msgs::Pose();
     arrow.pose.orientation.w = 1.0;
-    geometry_msgs::Point from, to;
-    to.x = d.grasp.translation().x();
-    to.y = d.grasp.translation().y();
-    to.z = d.grasp.translation().z();
-    from = to;
+    const geometry_msgs::Point to = tf2::toMsg(Eigen::Vector3d(d.grasp.translation()));
+    geometry_msgs::Point from = to;
     from.z += 0.06;
     arrow.points = {from, to};
     arrow.scale.x = 0.004;

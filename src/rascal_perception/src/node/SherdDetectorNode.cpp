@@ -1,5 +1,6 @@
 #include "SherdDetectorNode.hpp"
 
+#include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 
 #include "Conversions.hpp"
 #include "rascal_perception/Annotator.hpp"
+#include "rascal_workcell/ParameterServer.hpp"
 
 namespace rascal_perception {
 
@@ -16,50 +18,22 @@ constexpr const char* kOpticalFrame = "camera_color_optical_frame";
 constexpr size_t kBuffer = 15;  ///< frames kept per stream (0.5 s at 30 Hz)
 constexpr double kPairSlop = 0.015;  ///< [s] colour and depth stamps closer than this are one frame
 
-[[noreturn]] void fail(const std::string& key, const std::string& why) {
-  throw std::runtime_error("parameter " + key + ": " + why);
-}
-
-double number(const ros::NodeHandle& nh, const std::string& key, double lo, double hi, const double* def = nullptr) {
-  XmlRpc::XmlRpcValue v;
-  if (!nh.getParam(key, v)) {
-    if (def) return *def;
-    fail(key, "missing (load config/rascal.yaml with rosparam load)");
+/// The gripper from the URDF the rig runs (/robot_description), else rascal_description's.
+rascal_workcell::GripperGeometry gripperGeometry() {
+  std::string xml;
+  if (!ros::param::get("/robot_description", xml)) return rascal_workcell::GripperGeometry::fromPackageUrdf();
+  try {
+    return rascal_workcell::GripperGeometry::fromUrdf(xml);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("/robot_description: ") + e.what());
   }
-  double x;
-  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-    x = static_cast<double>(v);
-  } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-    x = static_cast<int>(v);
-  } else {
-    fail(key, "not a number");
-  }
-  if (!(x >= lo && x <= hi)) {
-    std::ostringstream s;
-    s << x << " outside [" << lo << ", " << hi << "]";
-    fail(key, s.str());
-  }
-  return x;
-}
-
-double optional(const ros::NodeHandle& nh, const std::string& key, double def, double lo, double hi) {
-  return number(nh, key, lo, hi, &def);
-}
-
-int integer(const ros::NodeHandle& nh, const std::string& key, int lo, int hi) {
-  XmlRpc::XmlRpcValue v;
-  if (!nh.getParam(key, v)) fail(key, "missing (load config/rascal.yaml with rosparam load)");
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) fail(key, "not an integer");
-  const int x = static_cast<int>(v);
-  if (x < lo || x > hi) fail(key, std::to_string(x) + " outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  return x;
 }
 }  // namespace
 
 SherdDetectorNode::SherdDetectorNode(ros::NodeHandle& root, ros::NodeHandle& private_nh) : tf_listener_(tf_buffer_) {
   (void)private_nh;
-  readParameters(root);
-  detector_ = std::make_unique<SherdDetector>(config_);
+  readParameters();
+  detector_ = std::make_unique<SherdDetector>(params_.config);
   colour_sub_ = root.subscribe("/camera/color/image_raw", 2, &SherdDetectorNode::onColour, this);
   depth_sub_ = root.subscribe("/camera/aligned_depth_to_color/image_raw", 2, &SherdDetectorNode::onDepth, this);
   info_sub_ = root.subscribe("/camera/color/camera_info", 1, &SherdDetectorNode::onInfo, this);
@@ -69,49 +43,23 @@ SherdDetectorNode::SherdDetectorNode(ros::NodeHandle& root, ros::NodeHandle& pri
   markers_pub_ = root.advertise<visualization_msgs::MarkerArray>("/rascal/detections", 1, true);
   annotated_pub_ = root.advertise<sensor_msgs::Image>("/rascal/perception/annotated", 1, true);
   std::ostringstream s;
-  for (const auto& [name, z] : surfaces_) s << " " << name << "@" << z;
-  ROS_INFO_STREAM("sherd_detector: started; stations" << s.str() << ", " << config_.background_clusters
-                                                      << " background clusters");
+  for (const rascal_workcell::Station& st : params_.workcell.stations()) s << " " << st.name << "@" << st.surface_z;
+  const PerceptionConfig& c = params_.config;
+  ROS_INFO_STREAM("sherd_detector: started; stations" << s.str() << ", " << c.background_clusters
+                                                      << " background clusters, gripper " << c.gripper.minOpening()
+                                                      << ".." << c.gripper.maxOpening() << " m, fingertips "
+                                                      << c.gripper.fingertip_offset << " m below ee_gripper_link");
 }
 
-void SherdDetectorNode::readParameters(ros::NodeHandle& nh) {
-  PerceptionConfig& c = config_;
-  c.background_clusters = integer(nh, "/perception/background_clusters", 1, 8);
-  c.hue_tolerance = number(nh, "/perception/hue_tolerance", 0.001, 0.5);
-  c.saturation_tolerance = number(nh, "/perception/saturation_tolerance", 0.001, 1.0);
-  c.min_value = number(nh, "/perception/min_value", 0.0, 0.99);
-  c.fixture_dilation = number(nh, "/perception/fixture_dilation", 0.0, 0.1);
-  c.min_sherd_size = number(nh, "/perception/min_sherd_size", 0.001, 0.5);
-  c.max_sherd_size = number(nh, "/perception/max_sherd_size", c.min_sherd_size, 1.0);
-  c.border_margin = integer(nh, "/perception/border_margin", 0, 100);
-  std::string policy;
-  if (!nh.getParam("/perception/selection_policy", policy)) {
-    fail("/perception/selection_policy", "missing or not a string (nearest | largest | most_isolated)");
-  }
-  try {
-    c.selection_policy = parseSelectionPolicy(policy);
-  } catch (const std::invalid_argument& e) {
-    fail("/perception/selection_policy", e.what());
-  }
-  c.depth_min = number(nh, "/perception/depth_min", 0.0, 10.0);
-  c.depth_max = number(nh, "/perception/depth_max", c.depth_min, 65.0);
-  c.grasp_height_fraction = optional(nh, "/perception/grasp_height_fraction", c.grasp_height_fraction, 0.1, 1.0);
-  c.grasp_tip_clearance = optional(nh, "/perception/grasp_tip_clearance", c.grasp_tip_clearance, 0.0, 0.05);
-  c.fingertip_offset = optional(nh, "/perception/fingertip_offset", c.fingertip_offset, -0.05, 0.05);
-  c.split_min_neck = optional(nh, "/perception/split_min_neck", c.split_min_neck, 0.1, 1.0);
-  c.min_sherd_height = optional(nh, "/perception/min_sherd_height", c.min_sherd_height, 0.0005, 0.05);
-  wait_s_ = optional(nh, "/perception/frame_wait", wait_s_, 0.05, 10.0);
-  refresh_period_ = optional(nh, "/perception/refresh_period", refresh_period_, 0.0, 86400.0);
-  c.grasp_margin = number(nh, "/arm/grasp_margin", 0.0, 0.05);
+void SherdDetectorNode::readParameters() {
+  const rascal_workcell::Parameters config = rascal_workcell::parametersFromServer("sherd_detector");
+  params_ = DetectorParameters::read(config, gripperGeometry());
+}
 
-  XmlRpc::XmlRpcValue stations;
-  if (!nh.getParam("/stations", stations) || stations.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
-    fail("/stations", "missing or not a map of stations");
-  }
-  for (auto it = stations.begin(); it != stations.end(); ++it) {
-    surfaces_[it->first] = number(nh, "/stations/" + it->first + "/surface_z", -1.0, 1.0);
-  }
-  if (surfaces_.empty()) fail("/stations", "no stations");
+const rascal_workcell::Station* SherdDetectorNode::findStation(const std::string& name, std::string& why) const {
+  const rascal_workcell::Station* s = params_.workcell.find(name);
+  if (!s) why = "unknown station '" + name + "' (not a station under stations in config/rascal.yaml)";
+  return s;
 }
 
 void SherdDetectorNode::onColour(const sensor_msgs::ImageConstPtr& msg) {
@@ -152,12 +100,12 @@ bool SherdDetectorNode::waitForFrame(const ros::Time& since, Frame& frame, std::
         if (frame.colour) return true;
       }
     }
-    if ((ros::Time::now() - since).toSec() > wait_s_ || (ros::WallTime::now() - wall_start).toSec() > 5.0 * wait_s_ + 2.0) {
+    if ((ros::Time::now() - since).toSec() > params_.frame_wait || (ros::WallTime::now() - wall_start).toSec() > 5.0 * params_.frame_wait + 2.0) {
       std::lock_guard<std::mutex> lock(mutex_);
       why = colours_.empty() ? "no image on /camera/color/image_raw"
                              : (depths_.empty() ? "no image on /camera/aligned_depth_to_color/image_raw"
                                                 : "no colour + depth pair stamped after the request within " +
-                                                      std::to_string(wait_s_) + " s");
+                                                      std::to_string(params_.frame_wait) + " s");
       return false;
     }
     ros::WallDuration(0.005).sleep();
@@ -191,7 +139,7 @@ bool SherdDetectorNode::prepare(const Frame& frame, cv::Mat& rgb, cv::Mat& depth
   const std::string& frame_id = frame.colour->header.frame_id.empty() ? kOpticalFrame : frame.colour->header.frame_id;
   try {
     const auto t = tf_buffer_.lookupTransform(base_frame_, frame_id, frame.colour->header.stamp, ros::Duration(0.5));
-    view.base_T_camera = conversions::toEigen(t.transform);
+    view.base_T_camera = tf2::transformToEigen(t);
   } catch (const tf2::TransformException& e) {
     why = "TF " + base_frame_ + " <- " + frame_id + ": " + e.what();
     return false;
@@ -203,21 +151,21 @@ bool SherdDetectorNode::onCalibrate(rascal_msgs::CalibrateBackground::Request& r
                                     rascal_msgs::CalibrateBackground::Response& res) {
   try {
     const ros::Time since = ros::Time::now();
-    auto station = surfaces_.find(req.station);
-    if (station == surfaces_.end()) {
-      res.message = "unknown station '" + req.station + "' (not a key under /stations)";
+    std::string why;
+    const rascal_workcell::Station* station = findStation(req.station, why);
+    if (!station) {
+      res.message = why;
       return true;
     }
     Frame frame;
     cv::Mat rgb, depth;
     CameraView view;
-    std::string why;
     if (!waitForFrame(since, frame, why) || !prepare(frame, rgb, depth, view, why)) {
       res.message = "station " + req.station + ": " + why;
       return true;
     }
     std::lock_guard<std::mutex> lock(detector_mutex_);
-    const CalibrationResult r = detector_->calibrate(req.station, rgb, depth, view, station->second);
+    const CalibrationResult r = detector_->calibrate(req.station, rgb, depth, view, station->surface_z);
     if (r.success) refreshed_[req.station] = frame.colour->header.stamp;
     res.success = r.success;
     res.message = r.message;
@@ -237,15 +185,15 @@ bool SherdDetectorNode::onDetect(rascal_msgs::Detect::Request& req, rascal_msgs:
     const ros::Time since = ros::Time::now();
     res.detections.station = req.station;
     res.detections.header.frame_id = base_frame_;
-    auto station = surfaces_.find(req.station);
-    if (station == surfaces_.end()) {
-      res.message = "unknown station '" + req.station + "' (not a key under /stations)";
+    std::string why;
+    const rascal_workcell::Station* station = findStation(req.station, why);
+    if (!station) {
+      res.message = why;
       return true;
     }
     Frame frame;
     cv::Mat rgb, depth;
     CameraView view;
-    std::string why;
     if (!waitForFrame(since, frame, why) || !prepare(frame, rgb, depth, view, why)) {
       res.message = "station " + req.station + ": " + why;
       return true;
@@ -253,11 +201,11 @@ bool SherdDetectorNode::onDetect(rascal_msgs::Detect::Request& req, rascal_msgs:
     DetectionResult r;
     {
       std::lock_guard<std::mutex> lock(detector_mutex_);
-      r = detector_->detect(req.station, rgb, depth, view, station->second);
+      r = detector_->detect(req.station, rgb, depth, view, station->surface_z);
       // the paper refreshes its colour masks now and then: light drifts during a batch
       const ros::Time stamp = frame.colour->header.stamp;
-      if (r.success && refresh_period_ > 0 && (stamp - refreshed_[req.station]).toSec() >= refresh_period_) {
-        const CalibrationResult f = detector_->refresh(req.station, rgb, depth, view, station->second);
+      if (r.success && params_.refresh_period > 0 && (stamp - refreshed_[req.station]).toSec() >= params_.refresh_period) {
+        const CalibrationResult f = detector_->refresh(req.station, rgb, depth, view, station->surface_z);
         if (f.success) refreshed_[req.station] = stamp;
         ROS_INFO_STREAM("sherd_detector: " << f.message);
       }

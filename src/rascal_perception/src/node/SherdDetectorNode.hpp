@@ -15,35 +15,37 @@
 #include <mutex>
 #include <string>
 
+#include "rascal_perception/DetectorParameters.hpp"
 #include "rascal_perception/SherdDetector.hpp"
 
 namespace rascal_perception {
 
 class SherdDetectorNode {
  public:
-  /// Reads and checks every parameter (throws std::runtime_error naming the key), then
-  /// subscribes, serves and advertises.
+  /// Reads and checks every parameter through the schema (throws rascal_workcell::ParameterError
+  /// naming the key, std::runtime_error naming /robot_description), then subscribes, serves and
+  /// advertises.
   SherdDetectorNode(ros::NodeHandle& root, ros::NodeHandle& private_nh);
 
  private:
   struct Frame {
     sensor_msgs::ImageConstPtr colour, depth;
   };
-  void readParameters(ros::NodeHandle& root);
+  void readParameters();
   void onColour(const sensor_msgs::ImageConstPtr& msg);
   void onDepth(const sensor_msgs::ImageConstPtr& msg);
   void onInfo(const sensor_msgs::CameraInfoConstPtr& msg);
   bool onDetect(rascal_msgs::Detect::Request& req, rascal_msgs::Detect::Response& res);
   bool onCalibrate(rascal_msgs::CalibrateBackground::Request& req, rascal_msgs::CalibrateBackground::Response& res);
-  /// The first colour + depth pair stamped at or after `since` (waits up to wait_s of ROS time).
+  /// The first colour + depth pair stamped at or after `since` (waits up to frame_wait of ROS time).
   bool waitForFrame(const ros::Time& since, Frame& frame, std::string& why);
   /// Images, intrinsics and base_link <- optical frame of a pair.
   bool prepare(const Frame& frame, cv::Mat& rgb, cv::Mat& depth, CameraView& view, std::string& why);
 
-  PerceptionConfig config_;
-  std::map<std::string, double> surfaces_;  ///< station -> surface_z
-  double wait_s_ = 1.0;
-  double refresh_period_ = 0.0;  ///< [s] re-learn a station's colours after a detect this often (0 = never)
+  /// The workcell station a request names; nullptr (and `why`) when there is none of that name.
+  const rascal_workcell::Station* findStation(const std::string& name, std::string& why) const;
+
+  DetectorParameters params_;  ///< perception config, workcell, frame_wait, refresh_period
   std::map<std::string, ros::Time> refreshed_;  ///< last calibration or refresh per station
   std::string base_frame_ = "base_link";
 
