@@ -29,7 +29,7 @@ def test_shipped_config_passes():
 def test_config_hash_changes_with_content(shipped):
     a = config_from_dict(copy.deepcopy(shipped))
     changed = copy.deepcopy(shipped)
-    changed["survey"]["step"] = 0.15
+    changed["survey"]["settle_time"] = 0.2
     assert config_from_dict(changed).hash != a.hash
 
 
