@@ -1,6 +1,7 @@
 """The parameter schema is the one source of truth (issue 12): check_config (Python), the C++
 nodes' reading (rascal_workcell::Parameters, through its check_parameters tool) and the README
 tables agree with it. Core tier: no master."""
+
 import copy
 import glob
 import os
@@ -36,16 +37,20 @@ def _set(data, dotted, value):
         node[keys[-1]] = value
 
 
-@pytest.mark.parametrize("key,value,nearest", [
-    ("survey.stepp", 0.1, "survey.step"),
-    ("recover", {"max_grasp_attempts": 2}, "recovery"),
-    ("arm.gripper.held_margn", 0.002, "arm.gripper.held_margin"),
-    ("stations.camera.stand.heigth", 0.6, "stations.camera.stand.height"),
-    ("perception.fingertip_offset", 0.004, "perception."),  # from the URDF now, not a parameter
-    ("simulator.scenarios", "x.yaml", "simulator.scenario"),
-])
-def test_unknown_key_at_any_depth_is_refused_naming_the_nearest_known_key(shipped, key, value,
-                                                                         nearest):
+@pytest.mark.parametrize(
+    "key,value,nearest",
+    [
+        ("survey.stepp", 0.1, "survey.step"),
+        ("recover", {"max_grasp_attempts": 2}, "recovery"),
+        ("arm.gripper.held_margn", 0.002, "arm.gripper.held_margin"),
+        ("stations.camera.stand.heigth", 0.6, "stations.camera.stand.height"),
+        ("perception.fingertip_offset", 0.004, "perception."),  # from the URDF now, not a parameter
+        ("simulator.scenarios", "x.yaml", "simulator.scenario"),
+    ],
+)
+def test_unknown_key_at_any_depth_is_refused_naming_the_nearest_known_key(
+    shipped, key, value, nearest
+):
     data = copy.deepcopy(shipped)
     _set(data, key, value)
     with pytest.raises(ConfigError) as e:
@@ -58,8 +63,9 @@ def test_unknown_key_at_any_depth_is_refused_naming_the_nearest_known_key(shippe
 def test_a_key_of_another_station_type_is_refused(shipped):
     data = copy.deepcopy(shipped)
     data["stations"]["scale"]["wall_height"] = 0.04
-    with pytest.raises(ConfigError, match="stations.scale.wall_height: not a key of a scale "
-                       "station"):
+    with pytest.raises(
+        ConfigError, match="stations.scale.wall_height: not a key of a scale " "station"
+    ):
         config_from_dict(data)
 
 
@@ -75,20 +81,23 @@ def test_a_missing_optional_key_takes_the_schema_default(shipped):
 def test_joint_values_are_checked_against_the_urdf_limits(shipped):
     data = copy.deepcopy(shipped)
     data["arm"]["named_poses"]["home"] = [0.0, 2.5, 0.0, 0.0, 0.0, 0.0]  # shoulder max 1.99
-    with pytest.raises(ConfigError, match="arm.named_poses.home: shoulder = 2.5 rad is outside "
-                       "its URDF limits"):
+    with pytest.raises(
+        ConfigError, match="arm.named_poses.home: shoulder = 2.5 rad is outside " "its URDF limits"
+    ):
         config_from_dict(data)
 
 
 # ---------------------------------------------------------------- C++ and Python agree
 def _concrete(spec, shipped):
     """A key of the shipped file that the schema entry covers (wildcards filled in)."""
+
     def leaves(node, prefix):
         for k, v in node.items():
             key = prefix + k
             yield key
             if isinstance(v, dict):
                 yield from leaves(v, key + ".")
+
     return next((k for k in leaves(shipped, "") if spec.matches(k)), None)
 
 
@@ -107,12 +116,14 @@ def _cases(shipped):
             cases.append((key, bound + sign * step, True))
             if not (which == "min" and spec.exclusive_min):
                 cases.append((key, bound, False))
-    cases += [("stations.scale.surface_z", 0.005, False),  # a flat scale: the sim refused < 11 mm
-              ("simulator.joint_state_period", 0.0005, True),  # below physics_step 0.001
-              ("perception.selection_policy", "random", True),
-              ("simulator.wrist_camera", "yes", True),
-              ("stations.scale.position", "abc", True),
-              ("simulator.archival_size", [2000, 1499], True)]
+    cases += [
+        ("stations.scale.surface_z", 0.005, False),  # a flat scale: the sim refused < 11 mm
+        ("simulator.joint_state_period", 0.0005, True),  # below physics_step 0.001
+        ("perception.selection_policy", "random", True),
+        ("simulator.wrist_camera", "yes", True),
+        ("stations.scale.position", "abc", True),
+        ("simulator.archival_size", [2000, 1499], True),
+    ]
     return cases
 
 
@@ -125,7 +136,8 @@ def _cpp_error(tmp_path, data):
 
 
 def test_the_nodes_accept_every_value_check_config_accepts_and_refuse_the_same_keys(
-        shipped, tmp_path):
+    shipped, tmp_path
+):
     assert os.path.exists(CHECK), "build rascal_workcell first (make test does)"
     disagree = []
     for key, value, must_fail in _cases(shipped):
@@ -140,14 +152,19 @@ def test_the_nodes_accept_every_value_check_config_accepts_and_refuse_the_same_k
         if must_fail and (py is None or cpp is None or key not in cpp):
             disagree.append("%s=%r: python %r, nodes %r (both must refuse)" % (key, value, py, cpp))
         if py is None and cpp is not None:
-            disagree.append("%s=%r passes check_config but a node refuses it: %s" % (
-                key, value, cpp))
+            disagree.append(
+                "%s=%r passes check_config but a node refuses it: %s" % (key, value, cpp)
+            )
     assert not disagree, "\n".join(disagree)
 
 
 # ---------------------------------------------------------------- README tables
-NODE_READMES = {"rascal_control": "arm_controller", "rascal_sim": "sim",
-                "rascal_perception": "sherd_detector", "rascal_tasks": "rascal"}
+NODE_READMES = {
+    "rascal_control": "arm_controller",
+    "rascal_sim": "sim",
+    "rascal_perception": "sherd_detector",
+    "rascal_tasks": "rascal",
+}
 
 
 @pytest.mark.parametrize("package,reader", sorted(NODE_READMES.items()))
@@ -156,10 +173,13 @@ def test_every_node_readme_lists_exactly_the_schema_keys_it_reads(package, reade
     with open(path) as f:
         text = f.read()
     assert "<!-- BEGIN parameters %s -->" % reader in text, (
-        "%s: add the marker lines and run `rosrun rascal_workcell parameter_tables`" % path)
+        "%s: add the marker lines and run `rosrun rascal_workcell parameter_tables`" % path
+    )
     assert readme_tables.render(text) == text, (
-        "%s: parameter table is stale; run `rosrun rascal_workcell parameter_tables`" % path)
-    listed = re.findall(r"^\| `([^`]+)` \|", text, re.M)
+        "%s: parameter table is stale; run `rosrun rascal_workcell parameter_tables`" % path
+    )
+    block = next(m.group(3) for m in readme_tables.MARKER.finditer(text) if m.group(2) == reader)
+    listed = re.findall(r"^\| `([^`]+)` \|", block, re.M)
     assert listed == [s.key for s in schema.builtin().for_reader(reader)]
 
 
@@ -183,7 +203,10 @@ def test_the_task_layer_reads_only_keys_the_schema_lists_for_it():
         with open(path) as f:
             for m in pattern.finditer(f.read()):
                 key = ".".join(p for p in m.groups() if p)
-                if m.group(1) in sections and key not in declared and not any(
-                        d.startswith(key + ".") for d in declared):
+                if (
+                    m.group(1) in sections
+                    and key not in declared
+                    and not any(d.startswith(key + ".") for d in declared)
+                ):
                     wrong.append("%s: %s" % (os.path.relpath(path, WORKSPACE), key))
     assert not wrong, "reads not declared for reader rascal in the schema: %s" % wrong
