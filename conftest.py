@@ -6,6 +6,7 @@
 - Catalogue and end-to-end tests use `pg_dsn`: a throw-away database on the PostgreSQL server
   that `scripts/setup.sh` started.
 """
+
 import os
 import subprocess
 import uuid
@@ -17,7 +18,8 @@ from rascal_tasks.sim_rig import RosMaster, stop
 WORKSPACE = os.path.dirname(os.path.abspath(__file__))
 CONFIG = os.path.join(WORKSPACE, "config", "rascal.yaml")
 PG_ADMIN_DSN = os.environ.get(
-    "RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0.1:5432/rascal")
+    "RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0.1:5432/rascal"
+)
 
 
 class Rosrun:
@@ -31,8 +33,13 @@ class Rosrun:
         e = dict(self.master.env, **(env or {}))
         popen_kw.setdefault("stdout", subprocess.PIPE)
         popen_kw.setdefault("stderr", subprocess.STDOUT)
-        proc = subprocess.Popen(["rosrun", package, executable, *args], env=e, text=True,
-                                start_new_session=True, **popen_kw)
+        proc = subprocess.Popen(
+            ["rosrun", package, executable, *args],
+            env=e,
+            text=True,
+            start_new_session=True,
+            **popen_kw,
+        )
         self.procs.append(proc)
         return proc
 
@@ -74,7 +81,8 @@ def pg_dsn():
     dsn = PG_ADMIN_DSN.rsplit("/", 1)[0] + "/" + name
     yield dsn
     with admin.cursor() as cur:
-        cur.execute("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s",
-                    (name,))
+        cur.execute(
+            "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s", (name,)
+        )
         cur.execute("DROP DATABASE IF EXISTS " + name)
     admin.close()

@@ -1,6 +1,7 @@
 """End-to-end tests of the station workflow: a real master, the simulator, the arm controller
 and the detector started with rosrun, a real PostgreSQL database, and `rascal run` as a user
 types it. Slow (each batch is a few simulated minutes); they assert outcomes, never timings."""
+
 import os
 import signal
 import subprocess
@@ -27,7 +28,7 @@ def run_batch(rig, dsn, context, timeout=800):
     except subprocess.TimeoutExpired:
         proc.send_signal(signal.SIGINT)
         out, _ = proc.communicate(timeout=60)
-        raise AssertionError("batch did not finish:\n%s\n%s" % (out[-3000:], rig.tail()))
+        raise AssertionError("batch did not finish:\n%s\n%s" % (out[-3000:], rig.tail())) from None
     return proc.returncode, out
 
 
@@ -56,14 +57,18 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
     # about 21 g) and its mass matches that sherd's within 0.2 g.
     names = set()
     for r in recorded:
-        name = min(truth, key=lambda n: (truth[n][0] - r["pickup_x_m"]) ** 2
-                   + (truth[n][1] - r["pickup_y_m"]) ** 2)
+        name = min(
+            truth,
+            key=lambda n: (truth[n][0] - r["pickup_x_m"]) ** 2
+            + (truth[n][1] - r["pickup_y_m"]) ** 2,
+        )
         assert abs(r["mass_g"] - truth[name][2] * 1000) < 0.2, (r["seq"], name, r["mass_g"])
         names.add(name)
     assert len(names) == 3, recorded
     # The archival image exists, is the one recorded, and shows something on the mat.
     import cv2
     import hashlib
+
     for r in recorded:
         path = tmp_path / "archive" / r["image_path"]
         data = path.read_bytes()
@@ -71,9 +76,23 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
         img = cv2.imread(str(path))
         assert img.shape[1] >= 2000 and img.shape[0] >= 1500
         assert (path.with_suffix(".json")).exists()
-    report = subprocess.run(["rosrun", "rascal_tasks", "rascal", "--dsn", db, "report",
-                             "--context", "E2E-3", "--archive", str(tmp_path / "archive")],
-                            env=ros_master.env, capture_output=True, text=True)
+    report = subprocess.run(
+        [
+            "rosrun",
+            "rascal_tasks",
+            "rascal",
+            "--dsn",
+            db,
+            "report",
+            "--context",
+            "E2E-3",
+            "--archive",
+            str(tmp_path / "archive"),
+        ],
+        env=ros_master.env,
+        capture_output=True,
+        text=True,
+    )
     assert report.returncode == 0, report.stderr
     page = (tmp_path / "archive" / "E2E-3" / "report" / "index.html").read_text()
     assert page.count("<img ") == 3 and "<svg" in page
@@ -82,8 +101,9 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
 def test_database_down_gives_clear_error_and_arm_does_not_move(rig_factory, tmp_path):
     rig = rig_factory(archive=tmp_path / "archive")
     before = joint_positions(rig)
-    proc = rig.rascal("--dsn", "postgresql://rascal:rascal@127.0.0.1:1/rascal", "run",
-                      "--context", "E2E-DOWN")
+    proc = rig.rascal(
+        "--dsn", "postgresql://rascal:rascal@127.0.0.1:1/rascal", "run", "--context", "E2E-DOWN"
+    )
     out, _ = proc.communicate(timeout=120)
     assert proc.returncode == 3
     assert "database" in out and "cannot connect" in out
@@ -153,8 +173,9 @@ def test_killed_mid_batch_resumes_without_duplicates(rig_factory, db, tmp_path):
 
 
 def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
-    rig = rig_factory(scenario=os.path.join(SCENARIOS, "touching_2.yaml"),
-                      archive=tmp_path / "archive")
+    rig = rig_factory(
+        scenario=os.path.join(SCENARIOS, "touching_2.yaml"), archive=tmp_path / "archive"
+    )
     truth = ground_truth(rig)
     code, out = run_batch(rig, db, "E2E-TOUCH")
     assert code == 0, out[-3000:]

@@ -1,4 +1,5 @@
 """Core tests of the site configuration loader (no ROS master)."""
+
 import copy
 import os
 
@@ -48,7 +49,11 @@ _DELETE = object()
 
 # (dotted key, bad value, text the one-line error must contain)
 BAD = [
-    ("stations.scale.position", "abc", "stations.scale.position: expected [x, y] in metres, got 'abc'"),
+    (
+        "stations.scale.position",
+        "abc",
+        "stations.scale.position: expected [x, y] in metres, got 'abc'",
+    ),
     ("stations.scale.position", [0.3], "stations.scale.position: expected [x, y]"),
     ("stations.pickup.size", [0.3, -0.1], "stations.pickup.size: expected [length along x"),
     ("stations.scale.surface_z", "high", "stations.scale.surface_z: expected a number"),
@@ -56,7 +61,11 @@ BAD = [
     ("stations.discard.position", [0.9, -0.5], "stations.discard.position: station corner"),
     ("stations.scale.position", [0.16, 0.25], "overlaps station pickup"),
     ("stations.camera.place_at", [0.0, -0.30], "stations.camera.place_at: must lie inside"),
-    ("stations.camera.colour_chart.position", [0.6, -0.1], "stations.camera.colour_chart: must lie"),
+    (
+        "stations.camera.colour_chart.position",
+        [0.6, -0.1],
+        "stations.camera.colour_chart: must lie",
+    ),
     ("arm.travel_z", 0.03, "arm.travel_z: expected a number in metres in [0.05, 0.45], got 0.03"),
     ("arm.standby", [0.30, -0.30], "arm.standby: inside the archival camera's view"),
     ("arm.named_poses.home", [0, 0, 0], "arm.named_poses.home: expected 6 joint angles"),
@@ -64,7 +73,11 @@ BAD = [
     ("arm.travel_z", 0.26, "survey.z: expected at least arm.travel_z (0.26 m)"),
     ("survey.z", 0.45, "survey.z: too high to reach the survey pose"),
     ("survey.step", 0, "survey.step: expected a number in metres in [0.02, 0.5], got 0"),
-    ("perception.selection_policy", "random", "perception.selection_policy: expected one of nearest"),
+    (
+        "perception.selection_policy",
+        "random",
+        "perception.selection_policy: expected one of nearest",
+    ),
     ("perception.background_clusters", 2.5, "perception.background_clusters: expected an integer"),
     ("perception.max_sherd_size", 0.01, "perception.max_sherd_size: expected a number"),
     ("perception.depth_min", True, "perception.depth_min: expected a number"),
@@ -75,7 +88,11 @@ BAD = [
     ("recovery.max_grasp_attempts", 0, "recovery.max_grasp_attempts: expected an integer"),
     ("simulator.mat_colour", [0, 0, 2], "simulator.mat_colour: expected [r, g, b]"),
     ("simulator.scale_colours", [[0, 0, 0]], "simulator.scale_colours: expected two"),
-    ("simulator.archival_size", [640, 480], "simulator.archival_size: expected [width, height] of at least"),
+    (
+        "simulator.archival_size",
+        [640, 480],
+        "simulator.archival_size: expected [width, height] of at least",
+    ),
     ("simulator.wrist_camera", "yes", "simulator.wrist_camera: expected true or false"),
     ("survey.stepp", 0.1, "survey.stepp: unknown key"),
 ]

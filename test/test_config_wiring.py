@@ -1,4 +1,5 @@
 """Wiring tests of the configuration: rosparam load on a real master, read back by a node."""
+
 import os
 
 import yaml

@@ -1,12 +1,13 @@
 """Test set-up for rascal_tasks: makes `import rascal_tasks` work without sourcing a catkin
 devel space, and gives the smach tests a log-capturing fixture."""
+
 import os
 import sys
 
 import pytest
 from catalogue_helpers import FakeClock
 
-_SRC = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'src')
+_SRC = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "src")
 try:
     import rascal_tasks  # noqa: F401
 except ImportError:
@@ -28,21 +29,28 @@ class LogCapture:
 def logs():
     """Captures the core's log lines; restores the default loggers and shutdown hook after."""
     from rascal_tasks import smach
+
     cap = LogCapture()
-    smach.set_loggers(cap.make('info'), cap.make('warn'), cap.make('debug'), cap.make('error'))
+    smach.set_loggers(cap.make("info"), cap.make("warn"), cap.make("debug"), cap.make("error"))
     yield cap
-    smach.set_loggers(smach.log.__dict__['_default_info'], smach.log.__dict__['_default_warn'],
-                      smach.log.__dict__['_default_debug'], smach.log.__dict__['_default_error'])
+    smach.set_loggers(
+        smach.log.__dict__["_default_info"],
+        smach.log.__dict__["_default_warn"],
+        smach.log.__dict__["_default_debug"],
+        smach.log.__dict__["_default_error"],
+    )
     smach.set_shutdown_check(lambda: False)
 
 
 # --- catalogue fixtures (use the root conftest's `pg_dsn`: a fresh database per test) ---
+
 
 @pytest.fixture
 def migrated_dsn(pg_dsn):
     import psycopg2
 
     from rascal_tasks.catalogue import migrate
+
     conn = psycopg2.connect(pg_dsn)
     migrate(conn)
     conn.close()
@@ -52,7 +60,7 @@ def migrated_dsn(pg_dsn):
 @pytest.fixture
 def catalogue(migrated_dsn):
     from rascal_tasks.catalogue import Catalogue
-    cat = Catalogue.connect(migrated_dsn, rig='test-rig', config_hash='cafe0123',
-                            clock=FakeClock())
+
+    cat = Catalogue.connect(migrated_dsn, rig="test-rig", config_hash="cafe0123", clock=FakeClock())
     yield cat
     cat.close()

@@ -1,4 +1,5 @@
 """States and fixtures shared by the test_smach_* files (no ROS, no master)."""
+
 import threading
 import time
 
@@ -8,7 +9,7 @@ from rascal_tasks import smach
 class Setter(smach.State):
     """Writes `value` under output key `key` and returns `outcome`."""
 
-    def __init__(self, key='x', value=1, outcome='done', outcomes=('done',)):
+    def __init__(self, key="x", value=1, outcome="done", outcomes=("done",)):
         smach.State.__init__(self, outcomes=list(outcomes), output_keys=[key])
         self.key, self.value, self.outcome = key, value, outcome
 
@@ -20,20 +21,20 @@ class Setter(smach.State):
 class Getter(smach.State):
     """Reads input key `key` into `self.seen` and returns 'done'."""
 
-    def __init__(self, key='x'):
-        smach.State.__init__(self, outcomes=['done'], input_keys=[key])
+    def __init__(self, key="x"):
+        smach.State.__init__(self, outcomes=["done"], input_keys=[key])
         self.key = key
         self.seen = []
 
     def execute(self, ud):
         self.seen.append(ud[self.key])
-        return 'done'
+        return "done"
 
 
 class Returns(smach.State):
     """Returns a fixed outcome and counts its executions (records order in `log`)."""
 
-    def __init__(self, outcome='done', outcomes=('done',), log=None, name=None):
+    def __init__(self, outcome="done", outcomes=("done",), log=None, name=None):
         smach.State.__init__(self, outcomes=list(outcomes))
         self.outcome, self.runs, self.log, self.name = outcome, 0, log, name
 
@@ -46,8 +47,8 @@ class Returns(smach.State):
 
 class Raises(smach.State):
     def __init__(self, exc=None):
-        smach.State.__init__(self, outcomes=['done'])
-        self.exc = exc if exc is not None else RuntimeError('boom')
+        smach.State.__init__(self, outcomes=["done"])
+        self.exc = exc if exc is not None else RuntimeError("boom")
 
     def execute(self, ud):
         raise self.exc
@@ -57,7 +58,7 @@ class Waiter(smach.State):
     """Blocks until preempted (services it if `service`) or `timeout` passes."""
 
     def __init__(self, service=True, timeout=5.0, started=None):
-        smach.State.__init__(self, outcomes=['done', 'preempted'])
+        smach.State.__init__(self, outcomes=["done", "preempted"])
         self.service, self.timeout = service, timeout
         self.started = started or threading.Event()
         self.saw_preempt = False
@@ -70,7 +71,7 @@ class Waiter(smach.State):
                 self.saw_preempt = True
                 if self.service:
                     self.service_preempt()
-                    return 'preempted'
-                return 'done'
+                    return "preempted"
+                return "done"
             time.sleep(0.005)
-        return 'done'
+        return "done"

@@ -14,15 +14,19 @@ else the default DSN below. Errors are one line on stderr; exit status 0 = done,
 To add a subcommand: write ``_add_<name>(subparsers)`` that creates its parser and sets
 ``func``, and call it in ``build_parser``.
 """
+
 import argparse
 import os
 import re
 import sys
 import tempfile
 
-DEFAULT_DSN = 'postgresql://rascal:rascal@127.0.0.1:5432/rascal'
-_WORKSPACE_CONFIG = os.path.normpath(os.path.join(
-    os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', '..', 'config', 'rascal.yaml'))
+DEFAULT_DSN = "postgresql://rascal:rascal@127.0.0.1:5432/rascal"
+_WORKSPACE_CONFIG = os.path.normpath(
+    os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "..", "config", "rascal.yaml"
+    )
+)
 
 
 class UsageError(Exception):
@@ -31,13 +35,14 @@ class UsageError(Exception):
 
 def _mask(dsn):
     """The DSN with its password replaced by ***."""
-    dsn = re.sub(r'(://[^:/@]*:)[^@]*@', r'\1***@', dsn)
-    return re.sub(r'(password\s*=\s*)\S+', r'\1***', dsn)
+    dsn = re.sub(r"(://[^:/@]*:)[^@]*@", r"\1***@", dsn)
+    return re.sub(r"(password\s*=\s*)\S+", r"\1***", dsn)
 
 
 def load_site_config(path):
     """The validated site config (the lead's loader), or UsageError with its one line."""
     from rascal_tasks.config import ConfigError, load_config
+
     try:
         return load_config(path)
     except ConfigError as e:
@@ -45,10 +50,10 @@ def load_site_config(path):
 
 
 def _config_path(args):
-    path = args.config or os.environ.get('RASCAL_CONFIG')
+    path = args.config or os.environ.get("RASCAL_CONFIG")
     if path:
         return path
-    for candidate in (os.path.join('config', 'rascal.yaml'), _WORKSPACE_CONFIG):
+    for candidate in (os.path.join("config", "rascal.yaml"), _WORKSPACE_CONFIG):
         if os.path.isfile(candidate):
             return candidate
     return None
@@ -57,71 +62,77 @@ def _config_path(args):
 def resolve_database(args):
     """``(dsn, connect_timeout, where_it_came_from)``."""
     if args.dsn:
-        return args.dsn, 5.0, '--dsn'
-    if os.environ.get('RASCAL_DSN'):
-        return os.environ['RASCAL_DSN'], 5.0, 'RASCAL_DSN'
+        return args.dsn, 5.0, "--dsn"
+    if os.environ.get("RASCAL_DSN"):
+        return os.environ["RASCAL_DSN"], 5.0, "RASCAL_DSN"
     path = _config_path(args)
     if path:
         cfg = load_site_config(path)
-        db = cfg['database']
-        return db['dsn'], float(db.get('connect_timeout', 5.0)), path
-    return DEFAULT_DSN, 5.0, 'default'
+        db = cfg["database"]
+        return db["dsn"], float(db.get("connect_timeout", 5.0)), path
+    return DEFAULT_DSN, 5.0, "default"
 
 
 def connect(args):
     import psycopg2
+
     dsn, timeout, source = resolve_database(args)
     try:
-        conn = psycopg2.connect(dsn, connect_timeout=max(1, int(round(timeout))),
-                                application_name='rascal-cli')
+        conn = psycopg2.connect(
+            dsn, connect_timeout=max(1, int(round(timeout))), application_name="rascal-cli"
+        )
     except psycopg2.OperationalError as e:
-        first = (str(e).strip().splitlines() or ['unknown error'])[0]
-        raise RuntimeError('database %s (from %s): cannot connect: %s'
-                           % (_mask(dsn), source, first)) from None
+        first = (str(e).strip().splitlines() or ["unknown error"])[0]
+        raise RuntimeError(
+            "database %s (from %s): cannot connect: %s" % (_mask(dsn), source, first)
+        ) from None
     return conn, dsn, source
 
 
 # --- db ---
 def cmd_db_migrate(args, out):
     from rascal_tasks.catalogue import migrate
+
     conn, dsn, source = connect(args)
     try:
         done = migrate(conn, logger=_PrintLogger(out))
     finally:
         conn.close()
     if done:
-        print('migrated %s to version %d (%d applied)' % (_mask(dsn), done[-1], len(done)),
-              file=out)
+        print(
+            "migrated %s to version %d (%d applied)" % (_mask(dsn), done[-1], len(done)), file=out
+        )
     else:
-        print('%s: already up to date' % _mask(dsn), file=out)
+        print("%s: already up to date" % _mask(dsn), file=out)
     return 0
 
 
 def cmd_db_status(args, out):
     from rascal_tasks.catalogue import status
+
     conn, dsn, source = connect(args)
     try:
         rows = status(conn)
         with conn, conn.cursor() as cur:
-            cur.execute('SHOW server_version')
+            cur.execute("SHOW server_version")
             version = cur.fetchone()[0]
             counts = None
-            if rows and rows[0][3] == 'applied':
-                cur.execute('SELECT (SELECT count(*) FROM contexts), (SELECT count(*) FROM sherds)')
+            if rows and rows[0][3] == "applied":
+                cur.execute("SELECT (SELECT count(*) FROM contexts), (SELECT count(*) FROM sherds)")
                 counts = cur.fetchone()
     finally:
         conn.close()
-    print('database  %s (from %s), PostgreSQL %s' % (_mask(dsn), source, version), file=out)
+    print("database  %s (from %s), PostgreSQL %s" % (_mask(dsn), source, version), file=out)
     for v, name, applied_at, state in rows:
-        when = applied_at.strftime('%Y-%m-%d %H:%M:%S %Z') if applied_at else ''
-        print('  %04d_%-24s %-8s %s' % (v, name, state, when), file=out)
+        when = applied_at.strftime("%Y-%m-%d %H:%M:%S %Z") if applied_at else ""
+        print("  %04d_%-24s %-8s %s" % (v, name, state, when), file=out)
     if counts is not None:
-        print('contents  %d contexts, %d sherds' % counts, file=out)
-    behind = [r for r in rows if r[3] != 'applied']
+        print("contents  %d contexts, %d sherds" % counts, file=out)
+    behind = [r for r in rows if r[3] != "applied"]
     if behind:
-        print('schema    not up to date: run `rascal db migrate`', file=out)
+        print("schema    not up to date: run `rascal db migrate`", file=out)
         return 1
-    print('schema    up to date', file=out)
+    print("schema    up to date", file=out)
     return 0
 
 
@@ -129,6 +140,7 @@ def cmd_db_status(args, out):
 def cmd_export(args, out):
     from rascal_tasks.catalogue import export_records, to_csv, to_json, validate_context_id
     from rascal_tasks.catalogue.errors import FieldError
+
     try:
         validate_context_id(args.context)
     except FieldError as e:
@@ -138,28 +150,31 @@ def cmd_export(args, out):
         context, records = export_records(conn, args.context)
     finally:
         conn.close()
-    text = to_csv(records) if args.format == 'csv' else to_json(context, records)
-    if args.output in (None, '-'):
+    text = to_csv(records) if args.format == "csv" else to_json(context, records)
+    if args.output in (None, "-"):
         out.write(text)
     else:
         directory = os.path.dirname(os.path.abspath(args.output))
-        fd, tmp = tempfile.mkstemp(prefix='.rascal-export.', dir=directory)
+        fd, tmp = tempfile.mkstemp(prefix=".rascal-export.", dir=directory)
         try:
-            with os.fdopen(fd, 'w', encoding='utf-8', newline='') as f:
+            with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
                 f.write(text)
             os.replace(tmp, args.output)
         except BaseException:
             if os.path.exists(tmp):
                 os.unlink(tmp)
             raise
-        print('%d sherds of context %s written to %s' % (len(records), args.context,
-                                                          args.output), file=sys.stderr)
+        print(
+            "%d sherds of context %s written to %s" % (len(records), args.context, args.output),
+            file=sys.stderr,
+        )
     return 0
 
 
 # --- run and report ---
 def cmd_run(args, out):
     from rascal_tasks.run_batch import run
+
     return run(args.context, dsn=args.dsn)
 
 
@@ -167,13 +182,14 @@ def cmd_report(args, out):
     from rascal_tasks.catalogue import export_records, validate_context_id
     from rascal_tasks.catalogue.errors import FieldError
     from rascal_tasks.report import write_report
+
     try:
         validate_context_id(args.context)
     except FieldError as e:
         raise UsageError(str(e)) from None
     path = _config_path(args)
     if path is None:
-        raise UsageError('no site config found; pass --config config/rascal.yaml')
+        raise UsageError("no site config found; pass --config config/rascal.yaml")
     cfg = load_site_config(path)
     conn, _, _ = connect(args)
     try:
@@ -181,33 +197,38 @@ def cmd_report(args, out):
     finally:
         conn.close()
     if not records:
-        raise UsageError("context '%s': no sherds recorded (check the context id)"
-                         % args.context)
-    done = [r for r in records if r['status'] == 'done']
-    totals = [sum(r.get('t_%s_s' % k) or 0.0 for k in ('locomotion', 'grasping',
-                                                         'data_collection', 'perception'))
-              for r in done]
-    summary = {'sherds': len(records), 'done': len(done),
-               'lost': sum(r['status'] == 'lost' for r in records),
-               'drops': sum(r.get('drops') or 0 for r in records),
-               'mean time per recorded sherd': '%.1f s' % (sum(totals) / len(totals))
-               if totals else '–'}
-    archive = args.archive or cfg.resolve(cfg['archive']['root'])
+        raise UsageError("context '%s': no sherds recorded (check the context id)" % args.context)
+    done = [r for r in records if r["status"] == "done"]
+    totals = [
+        sum(
+            r.get("t_%s_s" % k) or 0.0
+            for k in ("locomotion", "grasping", "data_collection", "perception")
+        )
+        for r in done
+    ]
+    summary = {
+        "sherds": len(records),
+        "done": len(done),
+        "lost": sum(r["status"] == "lost" for r in records),
+        "drops": sum(r.get("drops") or 0 for r in records),
+        "mean time per recorded sherd": "%.1f s" % (sum(totals) / len(totals)) if totals else "–",
+    }
+    archive = args.archive or cfg.resolve(cfg["archive"]["root"])
     report = write_report(args.context, records, archive, summary)
-    print('report: %s' % report, file=out)
+    print("report: %s" % report, file=out)
     return 0
 
 
 def _add_run(sub):
-    run = sub.add_parser('run', help='record one bag: survey, pick, weigh, photograph, discard')
-    run.add_argument('--context', required=True, help='context id of the bag, e.g. TR1-1023')
+    run = sub.add_parser("run", help="record one bag: survey, pick, weigh, photograph, discard")
+    run.add_argument("--context", required=True, help="context id of the bag, e.g. TR1-1023")
     run.set_defaults(func=cmd_run)
 
 
 def _add_report(sub):
-    rep = sub.add_parser('report', help="write an HTML report of a context's sherds")
-    rep.add_argument('--context', required=True, help='context id, e.g. TR1-1023')
-    rep.add_argument('--archive', help='image archive root (default: archive.root of the config)')
+    rep = sub.add_parser("report", help="write an HTML report of a context's sherds")
+    rep.add_argument("--context", required=True, help="context id, e.g. TR1-1023")
+    rep.add_argument("--archive", help="image archive root (default: archive.root of the config)")
     rep.set_defaults(func=cmd_report)
 
 
@@ -222,29 +243,32 @@ class _PrintLogger:
 
 
 def _add_db(sub):
-    db = sub.add_parser('db', help='catalogue database: migrate | status')
-    dbsub = db.add_subparsers(dest='db_command', metavar='{migrate,status}')
+    db = sub.add_parser("db", help="catalogue database: migrate | status")
+    dbsub = db.add_subparsers(dest="db_command", metavar="{migrate,status}")
     dbsub.required = True
-    dbsub.add_parser('migrate', help='apply the SQL migrations (safe to re-run)').set_defaults(
-        func=cmd_db_migrate)
-    dbsub.add_parser('status', help='show the database and its migrations (exit 1 if behind)'
-                     ).set_defaults(func=cmd_db_status)
+    dbsub.add_parser("migrate", help="apply the SQL migrations (safe to re-run)").set_defaults(
+        func=cmd_db_migrate
+    )
+    dbsub.add_parser(
+        "status", help="show the database and its migrations (exit 1 if behind)"
+    ).set_defaults(func=cmd_db_status)
 
 
 def _add_export(sub):
-    ex = sub.add_parser('export', help="write a context's sherd records as CSV or JSON")
-    ex.add_argument('--context', required=True, help='context id, e.g. TR1-1023')
-    ex.add_argument('--format', required=True, choices=('csv', 'json'))
-    ex.add_argument('--output', '-o', help='file to write (default: standard output)')
+    ex = sub.add_parser("export", help="write a context's sherd records as CSV or JSON")
+    ex.add_argument("--context", required=True, help="context id, e.g. TR1-1023")
+    ex.add_argument("--format", required=True, choices=("csv", "json"))
+    ex.add_argument("--output", "-o", help="file to write (default: standard output)")
     ex.set_defaults(func=cmd_export)
 
 
 def build_parser():
-    p = argparse.ArgumentParser(prog='rascal', description='RASCAL: record pottery sherds.')
-    p.add_argument('--config', help='site config (default: $RASCAL_CONFIG or config/rascal.yaml)')
-    p.add_argument('--dsn', help='PostgreSQL DSN (default: $RASCAL_DSN, else database.dsn '
-                   'of the config)')
-    sub = p.add_subparsers(dest='command', metavar='COMMAND')
+    p = argparse.ArgumentParser(prog="rascal", description="RASCAL: record pottery sherds.")
+    p.add_argument("--config", help="site config (default: $RASCAL_CONFIG or config/rascal.yaml)")
+    p.add_argument(
+        "--dsn", help="PostgreSQL DSN (default: $RASCAL_DSN, else database.dsn " "of the config)"
+    )
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     _add_db(sub)
     _add_export(sub)
@@ -260,11 +284,12 @@ def main(argv=None, out=None):
     try:
         return args.func(args, out)
     except UsageError as e:
-        print('rascal: error: %s' % e, file=sys.stderr)
+        print("rascal: error: %s" % e, file=sys.stderr)
         return 2
     except Exception as e:  # one line for the operator; no traceback for expected failures
         from rascal_tasks.catalogue.errors import CatalogueError
+
         if isinstance(e, (CatalogueError, RuntimeError)):
-            print('rascal: error: %s' % e, file=sys.stderr)
+            print("rascal: error: %s" % e, file=sys.stderr)
             return 1
         raise

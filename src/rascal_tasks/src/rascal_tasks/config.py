@@ -14,6 +14,7 @@ Besides types and ranges it checks the layout as a whole: every station the arm 
 within the wx250s's top-down reach, and no two stations (or a station and the camera stand)
 overlap. No ROS in here.
 """
+
 import hashlib
 import json
 import math
@@ -68,16 +69,20 @@ class Rect:
         return [(cx - hx, cy - hy), (cx + hx, cy - hy), (cx + hx, cy + hy), (cx - hx, cy + hy)]
 
     def overlaps(self, other: "Rect") -> bool:
-        return (abs(self.center[0] - other.center[0]) * 2 < self.size[0] + other.size[0]
-                and abs(self.center[1] - other.center[1]) * 2 < self.size[1] + other.size[1])
+        return (
+            abs(self.center[0] - other.center[0]) * 2 < self.size[0] + other.size[0]
+            and abs(self.center[1] - other.center[1]) * 2 < self.size[1] + other.size[1]
+        )
 
     def contains(self, other: "Rect") -> bool:
         return all(self.has(c) for c in other.corners())
 
     def has(self, p) -> bool:
         """Whether the point p = (x, y) lies on the rectangle."""
-        return (abs(p[0] - self.center[0]) <= self.size[0] / 2 + 1e-9
-                and abs(p[1] - self.center[1]) <= self.size[1] / 2 + 1e-9)
+        return (
+            abs(p[0] - self.center[0]) <= self.size[0] / 2 + 1e-9
+            and abs(p[1] - self.center[1]) <= self.size[1] / 2 + 1e-9
+        )
 
 
 @dataclass(frozen=True)
@@ -129,8 +134,9 @@ class Config:
 
 
 def _fail(source: str, key: str, message: str, got=None, show_got=True):
-    raise ConfigError("%s: %s: %s%s" % (source, key, message, ", got %r" % (got,) if show_got
-                                        else ""))
+    raise ConfigError(
+        "%s: %s: %s%s" % (source, key, message, ", got %r" % (got,) if show_got else "")
+    )
 
 
 def load_config(path: str, workspace: Optional[str] = None) -> Config:
@@ -139,13 +145,15 @@ def load_config(path: str, workspace: Optional[str] = None) -> Config:
         with open(path, encoding="utf-8") as f:
             data = yaml.safe_load(f)
     except FileNotFoundError:
-        raise ConfigError("%s: file not found; pass the path of config/rascal.yaml"
-                          % path) from None
+        raise ConfigError(
+            "%s: file not found; pass the path of config/rascal.yaml" % path
+        ) from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = " (line %d)" % (mark.line + 1) if mark else ""
-        raise ConfigError("%s: not valid YAML%s: %s" % (
-            path, where, getattr(e, "problem", None) or e)) from None
+        raise ConfigError(
+            "%s: not valid YAML%s: %s" % (path, where, getattr(e, "problem", None) or e)
+        ) from None
     if workspace is None:
         workspace = os.path.dirname(os.path.dirname(os.path.abspath(path)))
     return config_from_dict(data, source=path, workspace=workspace)
@@ -163,41 +171,69 @@ def config_from_dict(data, source="config/rascal.yaml", workspace=".") -> Config
     _check_survey(source, checked, stations)
     dsn = checked["database"]["dsn"]
     if not (dsn.startswith(("postgresql://", "postgres://")) or "=" in dsn):
-        _fail(source, "database.dsn", "expected a libpq URI (postgresql://user:password@host:"
-              "port/dbname) or key=value string", dsn)
+        _fail(
+            source,
+            "database.dsn",
+            "expected a libpq URI (postgresql://user:password@host:"
+            "port/dbname) or key=value string",
+            dsn,
+        )
     sim = checked["simulator"]
     _check_joints(source, "simulator.initial_joints", sim["initial_joints"])
     lo, hi = urdf_model.finger_limits()
     if not lo <= sim["initial_finger"] <= hi:
-        _fail(source, "simulator.initial_finger", "expected a number in metres in [%g, %g] (the "
-              "URDF's finger limits)" % (lo, hi), sim["initial_finger"])
+        _fail(
+            source,
+            "simulator.initial_finger",
+            "expected a number in metres in [%g, %g] (the " "URDF's finger limits)" % (lo, hi),
+            sim["initial_finger"],
+        )
     return Config(source=source, workspace=workspace, data=checked, stations=stations)
 
 
 def _check_joints(source: str, key: str, q):
     for name, v, (lo, hi) in zip(ARM_JOINTS, q, urdf_model.arm_joint_limits(), strict=False):
         if not lo <= v <= hi:
-            _fail(source, key, "%s = %g rad is outside its URDF limits [%g, %g]" % (
-                name, v, lo, hi), list(q))
+            _fail(
+                source,
+                key,
+                "%s = %g rad is outside its URDF limits [%g, %g]" % (name, v, lo, hi),
+                list(q),
+            )
 
 
 def _check_survey(source: str, cfg: dict, stations: Dict[str, Station]):
     survey_z, step = cfg["survey"]["z"], cfg["survey"]["step"]
     if survey_z < cfg["arm"]["travel_z"]:
-        _fail(source, "survey.z", "expected at least arm.travel_z (%g m): the camera surveys "
-              "from above the travel height" % cfg["arm"]["travel_z"], survey_z)
+        _fail(
+            source,
+            "survey.z",
+            "expected at least arm.travel_z (%g m): the camera surveys "
+            "from above the travel height" % cfg["arm"]["travel_z"],
+            survey_z,
+        )
     pickup = next(s for s in stations.values() if s.type == "pickup")
     for cx, cy in lawnmower(pickup.area.center, pickup.area.size, step):
         if not top_down_reachable(cx, cy, survey_z):
-            _fail(source, "survey.z", "too high to reach the survey pose (%.3f, %.3f) m over the "
-                  "pickup area; lower it or move the pickup area closer" % (cx, cy), survey_z)
+            _fail(
+                source,
+                "survey.z",
+                "too high to reach the survey pose (%.3f, %.3f) m over the "
+                "pickup area; lower it or move the pickup area closer" % (cx, cy),
+                survey_z,
+            )
 
 
 def _only(source: str, stations, type_) -> str:
     names = [n for n, s in stations.items() if s.type == type_]
     if len(names) != 1:
-        _fail(source, "stations", "expected exactly one station of type %s" % type_, names,
-              show_got=bool(names))
+        _fail(
+            source,
+            "stations",
+            "expected exactly one station of type %s" % type_,
+            names,
+            show_got=bool(names),
+        )
     return names[0]
 
 
@@ -224,39 +260,64 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
             extra["stand"] = Fixture(_rect(st["stand"]), st["stand"]["height"])
             for part in ("colour_chart", "scale_bar"):
                 if not area.contains(extra[part].area):
-                    _fail(source, "%s.%s" % (key, part), "must lie inside the camera's field of "
-                          "view %s" % _fmt_rect(area), _fmt_rect(extra[part].area))
+                    _fail(
+                        source,
+                        "%s.%s" % (key, part),
+                        "must lie inside the camera's field of " "view %s" % _fmt_rect(area),
+                        _fmt_rect(extra[part].area),
+                    )
             if not area.has(place_at):
-                _fail(source, key + ".place_at", "must lie inside the camera's field of view %s"
-                      % _fmt_rect(area), list(place_at))
+                _fail(
+                    source,
+                    key + ".place_at",
+                    "must lie inside the camera's field of view %s" % _fmt_rect(area),
+                    list(place_at),
+                )
             if not top_down_reachable(place_at[0], place_at[1], surface_z):
-                _fail(source, key + ".place_at", "outside the arm's top-down reach (%.2f m from "
-                      "the base); move it closer" % math.hypot(*place_at), list(place_at))
+                _fail(
+                    source,
+                    key + ".place_at",
+                    "outside the arm's top-down reach (%.2f m from "
+                    "the base); move it closer" % math.hypot(*place_at),
+                    list(place_at),
+                )
         else:
             place_at = area.center
             if type_ == "discard":
                 extra["wall_height"] = st["wall_height"]
             for cx, cy in area.corners():
                 if not top_down_reachable(cx, cy, surface_z):
-                    _fail(source, key + ".position", "station corner (%.3f, %.3f) is outside "
-                          "the arm's top-down reach (%.2f..%.2f m from the base); move or shrink "
-                          "the station" % (cx, cy, MIN_RADIUS, _max_radius(surface_z)),
-                          list(area.center))
+                    _fail(
+                        source,
+                        key + ".position",
+                        "station corner (%.3f, %.3f) is outside "
+                        "the arm's top-down reach (%.2f..%.2f m from the base); move or shrink "
+                        "the station" % (cx, cy, MIN_RADIUS, _max_radius(surface_z)),
+                        list(area.center),
+                    )
         stations[name] = Station(name, type_, area, surface_z, place_at, **extra)
 
     for type_ in REQUIRED_STATION_TYPES:
         _only(source, stations, type_)
     names = list(stations)
     for i, a in enumerate(names):
-        for b in names[i + 1:]:
+        for b in names[i + 1 :]:
             if stations[a].area.overlaps(stations[b].area):
-                _fail(source, "stations." + b, "overlaps station %s %s; move one of them" % (
-                    a, _fmt_rect(stations[a].area)), _fmt_rect(stations[b].area))
+                _fail(
+                    source,
+                    "stations." + b,
+                    "overlaps station %s %s; move one of them" % (a, _fmt_rect(stations[a].area)),
+                    _fmt_rect(stations[b].area),
+                )
     cam = stations[_only(source, stations, "archival_camera")]
     for name, s in stations.items():
         if s is not cam and s.area.overlaps(cam.stand.area):
-            _fail(source, "stations." + name, "overlaps the archival camera stand %s"
-                  % _fmt_rect(cam.stand.area), _fmt_rect(s.area))
+            _fail(
+                source,
+                "stations." + name,
+                "overlaps the archival camera stand %s" % _fmt_rect(cam.stand.area),
+                _fmt_rect(s.area),
+            )
     return stations
 
 
@@ -265,22 +326,32 @@ def _check_arm(source: str, arm: dict, stations: Dict[str, Station]):
     walls = max(s.wall_height for s in stations.values())
     travel_z = arm["travel_z"]
     if travel_z < max(highest, walls) + 0.05:
-        _fail(source, "arm.travel_z", "expected at least 0.05 m above the highest station "
-              "surface or wall (%.3f m)" % max(highest, walls), travel_z)
+        _fail(
+            source,
+            "arm.travel_z",
+            "expected at least 0.05 m above the highest station "
+            "surface or wall (%.3f m)" % max(highest, walls),
+            travel_z,
+        )
     standby = tuple(arm["standby"])
     if not top_down_reachable(standby[0], standby[1], travel_z):
         _fail(source, "arm.standby", "outside the arm's top-down reach at travel_z", list(standby))
     cam = next(s for s in stations.values() if s.type == "archival_camera")
     if cam.area.has(standby):
-        _fail(source, "arm.standby", "inside the archival camera's view %s; the arm must park "
-              "out of view" % _fmt_rect(cam.area), list(standby))
+        _fail(
+            source,
+            "arm.standby",
+            "inside the archival camera's view %s; the arm must park "
+            "out of view" % _fmt_rect(cam.area),
+            list(standby),
+        )
     for name, q in arm["named_poses"].items():
         _check_joints(source, "arm.named_poses." + name, q)
 
 
 def _max_radius(z: float) -> float:
     dz = z + WRIST_TO_EE - SHOULDER_Z
-    return math.sqrt(max(MAX_WRIST_DISTANCE ** 2 - dz * dz, 0.0))
+    return math.sqrt(max(MAX_WRIST_DISTANCE**2 - dz * dz, 0.0))
 
 
 def _fmt_rect(r: Rect) -> str:

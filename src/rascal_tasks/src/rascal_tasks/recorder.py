@@ -3,6 +3,7 @@
 Binds the catalogue (PostgreSQL) and the image archive to one context and speaks in the
 workflow's units (kg, m, s); the catalogue keeps the archaeologists' units (g, mm). No ROS here.
 """
+
 import os
 from typing import List, Tuple
 
@@ -10,8 +11,9 @@ from rascal_tasks.catalogue import Catalogue, ImageArchive
 
 
 class Recorder:
-    def __init__(self, catalogue: Catalogue, archive: ImageArchive, context: str, site: str,
-                 log=None):
+    def __init__(
+        self, catalogue: Catalogue, archive: ImageArchive, context: str, site: str, log=None
+    ):
         self.catalogue = catalogue
         self.archive = archive
         self.context = context
@@ -27,20 +29,26 @@ class Recorder:
         return self._ids[seq]
 
     def new_sherd(self, pickup_xy, attempts: int = 1) -> int:
-        rec = self.catalogue.new_sherd(self.context, pickup_xy=list(pickup_xy),
-                                       grasp_attempts=attempts)
+        rec = self.catalogue.new_sherd(
+            self.context, pickup_xy=list(pickup_xy), grasp_attempts=attempts
+        )
         self._ids[rec["seq"]] = rec["sherd_id"]
         return rec["seq"]
 
     def dimensions(self, seq, length, width, thickness):
-        self.catalogue.record_dimensions(self._id(seq), length * 1000.0, width * 1000.0,
-                                         thickness * 1000.0 if thickness > 0 else None)
+        self.catalogue.record_dimensions(
+            self._id(seq),
+            length * 1000.0,
+            width * 1000.0,
+            thickness * 1000.0 if thickness > 0 else None,
+        )
 
     def mass(self, seq, kg: float, stable: bool, seconds: float = None):
         self.catalogue.record_mass(self._id(seq), kg * 1000.0, t_weigh_s=seconds)
         if not stable:
-            self.catalogue.add_note(self._id(seq), "scale reading not stable: %.1f g" % (
-                kg * 1000.0))
+            self.catalogue.add_note(
+                self._id(seq), "scale reading not stable: %.1f g" % (kg * 1000.0)
+            )
 
     def spool_path(self, seq: int) -> str:
         """Where the archival camera writes before the archive takes the file over."""
@@ -50,8 +58,9 @@ class Recorder:
 
     def photo(self, seq, image_path: str, seconds: float = None) -> str:
         """Archive the captured file atomically, then record its path and SHA-256."""
-        rec = self.catalogue.archive_photo(self._id(seq), self.archive, image_path,
-                                           t_photo_s=seconds)
+        rec = self.catalogue.archive_photo(
+            self._id(seq), self.archive, image_path, t_photo_s=seconds
+        )
         try:
             os.unlink(image_path)
         except OSError:
@@ -59,8 +68,9 @@ class Recorder:
         return self.archive.path(self.catalogue.get(rec["sherd_id"])["image_path"])
 
     def done(self, seq, seconds: float = None, timings: dict = None):
-        self.catalogue.record_done(self._id(seq), t_discard_s=seconds, timings=timings,
-                                   archive=self.archive)
+        self.catalogue.record_done(
+            self._id(seq), t_discard_s=seconds, timings=timings, archive=self.archive
+        )
 
     def lost(self, seq, reason: str, timings: dict = None):
         self.catalogue.record_lost(self._id(seq), reason, timings=timings)
@@ -80,8 +90,9 @@ class Recorder:
         if self._unfinished is None:  # the catalogue logs a resume once per run
             rows = self.catalogue.resume(self.context)
             self._ids.update({r["seq"]: r["sherd_id"] for r in rows})
-            self._unfinished = [(r["seq"], r["status"], (r["pickup_x_m"], r["pickup_y_m"]))
-                                for r in rows]
+            self._unfinished = [
+                (r["seq"], r["status"], (r["pickup_x_m"], r["pickup_y_m"])) for r in rows
+            ]
         return self._unfinished
 
     def rows(self):

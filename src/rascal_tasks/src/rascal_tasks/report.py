@@ -4,11 +4,16 @@ time went (the paper's Fig. 10 breakdown: locomotion, grasping, data collection,
 Input is the catalogue's export rows (dicts); output one self-contained folder
 `<archive>/<context>/report/` with `index.html` and JPEG thumbnails. No ROS here.
 """
+
 import html
 import os
 
-PHASES = (("locomotion", "#4e79a7"), ("grasping", "#f28e2b"),
-          ("data_collection", "#59a14f"), ("perception", "#b07aa1"))
+PHASES = (
+    ("locomotion", "#4e79a7"),
+    ("grasping", "#f28e2b"),
+    ("data_collection", "#59a14f"),
+    ("perception", "#b07aa1"),
+)
 
 
 def _thumbnail(src: str, dst: str, width: int = 240) -> bool:
@@ -37,25 +42,32 @@ def _breakdown_svg(rows) -> str:
     longest = max([sum(b[1]) for b in bars] + [1.0])
     scale = 520.0 / longest
     row_h, left = 22, 60
-    out = ['<svg xmlns="http://www.w3.org/2000/svg" width="720" height="%d" font-size="12" '
-           'font-family="sans-serif">' % (row_h * (len(bars) + 2) + 10)]
+    out = [
+        '<svg xmlns="http://www.w3.org/2000/svg" width="720" height="%d" font-size="12" '
+        'font-family="sans-serif">' % (row_h * (len(bars) + 2) + 10)
+    ]
     for i, (label, parts) in enumerate(bars):
         y = 5 + i * row_h
-        out.append('<text x="%d" y="%d" text-anchor="end">%s</text>' % (
-            left - 6, y + 14, html.escape(label)))
+        out.append(
+            '<text x="%d" y="%d" text-anchor="end">%s</text>'
+            % (left - 6, y + 14, html.escape(label))
+        )
         x = left
         for (phase, colour), secs in zip(PHASES, parts, strict=True):
             w = secs * scale
-            out.append('<rect x="%.1f" y="%d" width="%.1f" height="16" fill="%s">'
-                       '<title>%s %.1f s</title></rect>' % (x, y, w, colour, phase, secs))
+            out.append(
+                '<rect x="%.1f" y="%d" width="%.1f" height="16" fill="%s">'
+                "<title>%s %.1f s</title></rect>" % (x, y, w, colour, phase, secs)
+            )
             x += w
         out.append('<text x="%.1f" y="%d">%.1f s</text>' % (x + 4, y + 13, sum(parts)))
     y = 10 + len(bars) * row_h
     for i, (phase, colour) in enumerate(PHASES):
-        out.append('<rect x="%d" y="%d" width="12" height="12" fill="%s"/>'
-                   '<text x="%d" y="%d">%s</text>' % (left + i * 150, y, colour,
-                                                      left + i * 150 + 16, y + 10,
-                                                      phase.replace("_", " ")))
+        out.append(
+            '<rect x="%d" y="%d" width="12" height="12" fill="%s"/>'
+            '<text x="%d" y="%d">%s</text>'
+            % (left + i * 150, y, colour, left + i * 150 + 16, y + 10, phase.replace("_", " "))
+        )
     out.append("</svg>")
     return "".join(out)
 
@@ -75,13 +87,23 @@ def write_report(context: str, rows, archive_root: str, summary: dict = None) ->
                 thumb = '<img src="%s" alt="sherd %d">' % (name, r["seq"])
         cells.append(
             "<tr><td>%d</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td>"
-            "<td>%s</td><td>%s</td></tr>" % (
-                r["seq"], html.escape(str(r.get("status", ""))), thumb,
-                _fmt(r.get("mass_g")), _fmt(r.get("length_mm")), _fmt(r.get("width_mm")),
-                _fmt(r.get("thickness_mm")), _fmt(r.get("drops"), "%d"),
-                html.escape(r.get("lost_reason") or "")))
-    lines = "".join("<li>%s: %s</li>" % (html.escape(k), html.escape(str(v)))
-                    for k, v in (summary or {}).items())
+            "<td>%s</td><td>%s</td></tr>"
+            % (
+                r["seq"],
+                html.escape(str(r.get("status", ""))),
+                thumb,
+                _fmt(r.get("mass_g")),
+                _fmt(r.get("length_mm")),
+                _fmt(r.get("width_mm")),
+                _fmt(r.get("thickness_mm")),
+                _fmt(r.get("drops"), "%d"),
+                html.escape(r.get("lost_reason") or ""),
+            )
+        )
+    lines = "".join(
+        "<li>%s: %s</li>" % (html.escape(k), html.escape(str(v)))
+        for k, v in (summary or {}).items()
+    )
     page = """<!DOCTYPE html><html><head><meta charset="utf-8">
 <title>RASCAL context %(ctx)s</title>
 <style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}
@@ -91,8 +113,12 @@ td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}img{max-width:240px
 <h2>Sherds</h2><table><tr><th>#</th><th>status</th><th>archival image</th><th>mass (g)</th>
 <th>length (mm)</th><th>width (mm)</th><th>thickness (mm)</th><th>drops</th><th>note</th></tr>
 %(rows)s</table></body></html>
-""" % {"ctx": html.escape(context), "summary": lines, "svg": _breakdown_svg(rows),
-       "rows": "\n".join(cells)}
+""" % {
+        "ctx": html.escape(context),
+        "summary": lines,
+        "svg": _breakdown_svg(rows),
+        "rows": "\n".join(cells),
+    }
     path = os.path.join(folder, "index.html")
     tmp = path + ".tmp"
     with open(tmp, "w", encoding="utf-8") as f:

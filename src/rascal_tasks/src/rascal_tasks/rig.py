@@ -4,6 +4,7 @@ The workflow core talks only to these small interfaces; `ros_rig.py` implements 
 (the arm controller's actions, the detector's services, the scale topic, the archival camera
 service). Tests can run the core against the simulator through the same adapters. No ROS here.
 """
+
 import math
 from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
@@ -78,9 +79,12 @@ class Timings:
         return self.locomotion + self.grasping + self.data_collection + self.perception
 
     def as_dict(self) -> dict:
-        return {"locomotion": round(self.locomotion, 3), "grasping": round(self.grasping, 3),
-                "data_collection": round(self.data_collection, 3),
-                "perception": round(self.perception, 3)}
+        return {
+            "locomotion": round(self.locomotion, 3),
+            "grasping": round(self.grasping, 3),
+            "data_collection": round(self.data_collection, 3),
+            "perception": round(self.perception, 3),
+        }
 
 
 class Arm:

@@ -4,6 +4,7 @@
 every Python node calls `load_from_param_server()` before it advertises anything and exits with
 the validator's one-line message when something is wrong.
 """
+
 import os
 
 import rospkg
@@ -29,6 +30,8 @@ def load_from_param_server(source="parameter server (rosparam load config/rascal
         if rospy.has_param("/" + key):
             data[key] = rospy.get_param("/" + key)
     if not data:
-        raise ConfigError("%s: no RASCAL configuration found; run `rosparam load "
-                          "config/rascal.yaml` first" % source)
+        raise ConfigError(
+            "%s: no RASCAL configuration found; run `rosparam load "
+            "config/rascal.yaml` first" % source
+        )
     return config_from_dict(data, source=source, workspace=workspace_root())

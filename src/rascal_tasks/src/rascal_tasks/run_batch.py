@@ -3,6 +3,7 @@ progress line. The node wrapper of the workflow core: reads and checks the confi
 connects the catalogue *before* anything moves, wires the rig over ROS, runs the machine, and
 turns Ctrl-C into a preempt that parks the arm.
 """
+
 import signal
 import sys
 import threading
@@ -37,7 +38,11 @@ class ProgressLine:
         k = b.sherd.seq if b.sherd else b.completed + b.lost + 1
         per = b.per_sherd()
         line = "sherd %3d | %-22s | %7.1f s | %s" % (
-            k, state[:22], elapsed, "%.1f s/sherd" % per if per else "–")
+            k,
+            state[:22],
+            elapsed,
+            "%.1f s/sherd" % per if per else "–",
+        )
         if self.tty:
             self.out.write("\r" + line + "   ")
         else:
@@ -64,16 +69,19 @@ def run(context: str, dsn: str = None) -> int:
     dsn = dsn or db["dsn"]
     # The catalogue first: if it is down, nothing may move.
     try:
-        catalogue = Catalogue.connect(dsn, rig=cfg["rig"]["name"], config_hash=cfg.hash,
-                                      connect_timeout=db["connect_timeout"])
+        catalogue = Catalogue.connect(
+            dsn, rig=cfg["rig"]["name"], config_hash=cfg.hash, connect_timeout=db["connect_timeout"]
+        )
         catalogue.check_schema()
     except CatalogueError as e:
-        return fail("database: %s (database.dsn in config/rascal.yaml; `rascal db migrate` "
-                    "creates the tables)" % e, 3)
+        return fail(
+            "database: %s (database.dsn in config/rascal.yaml; `rascal db migrate` "
+            "creates the tables)" % e,
+            3,
+        )
     archive = ImageArchive(cfg.resolve(cfg["archive"]["root"]))
     try:
-        recorder = Recorder(catalogue, archive, context, cfg["rig"]["site"],
-                            log=rospy.loginfo)
+        recorder = Recorder(catalogue, archive, context, cfg["rig"]["site"], log=rospy.loginfo)
         rig = make_rig(cfg)
     except (CatalogueError, RigError) as e:
         return fail(str(e), 3)
@@ -92,8 +100,7 @@ def run(context: str, dsn: str = None) -> int:
             rig.arm.stop()
             return
         stop.set()
-        print("\nstopping: parking the arm (Ctrl-C again stops it where it is)",
-              file=sys.stderr)
+        print("\nstopping: parking the arm (Ctrl-C again stops it where it is)", file=sys.stderr)
         batch.stop_requested.set()
         machine.request_preempt()
 
@@ -108,34 +115,69 @@ def run(context: str, dsn: str = None) -> int:
 
 
 def make_rig(cfg) -> Rig:
-    from rascal_tasks.ros_rig import (RosArchivalCamera, RosArm, RosClock, RosGripper,
-                                      RosPerception, RosScale)
+    from rascal_tasks.ros_rig import (
+        RosArchivalCamera,
+        RosArm,
+        RosClock,
+        RosGripper,
+        RosPerception,
+        RosScale,
+    )
+
     clock = RosClock()
-    return Rig(arm=RosArm(), gripper=RosGripper(cfg["arm"]["gripper"]["held_margin"]),
-               perception=RosPerception(),
-               scale=RosScale(clock), camera=RosArchivalCamera(), clock=clock)
+    return Rig(
+        arm=RosArm(),
+        gripper=RosGripper(cfg["arm"]["gripper"]["held_margin"]),
+        perception=RosPerception(),
+        scale=RosScale(clock),
+        camera=RosArchivalCamera(),
+        clock=clock,
+    )
 
 
 def print_summary(batch, recorder, outcome, wall_seconds):
     rows = recorder.rows()
     sim = batch.rig.clock.now() - batch.started
     n = batch.completed + batch.lost
-    print("batch %s: %s — %d recorded, %d lost, %.1f s (%s), wall %.1f s" % (
-        batch.context, outcome, batch.completed, batch.lost, sim,
-        "%.1f s/sherd" % (sim / n) if n else "no sherds", wall_seconds))
+    print(
+        "batch %s: %s — %d recorded, %d lost, %.1f s (%s), wall %.1f s"
+        % (
+            batch.context,
+            outcome,
+            batch.completed,
+            batch.lost,
+            sim,
+            "%.1f s/sherd" % (sim / n) if n else "no sherds",
+            wall_seconds,
+        )
+    )
     for x, y in batch.unpickable:
-        print("left in the pickup area (could not be picked up): sherd at (%.3f, %.3f) m"
-              % (x, y))
+        print("left in the pickup area (could not be picked up): sherd at (%.3f, %.3f) m" % (x, y))
     if batch.state_times:
-        print("time per state (s): " + ", ".join(
-            "%s %.1f" % kv for kv in sorted(batch.state_times.items(), key=lambda kv: -kv[1])))
-    print("%4s  %-13s %9s %9s %9s %9s %6s  %s" % ("seq", "status", "mass g", "length mm",
-                                                  "width mm", "thick mm", "drops", "image"))
+        print(
+            "time per state (s): "
+            + ", ".join(
+                "%s %.1f" % kv for kv in sorted(batch.state_times.items(), key=lambda kv: -kv[1])
+            )
+        )
+    print(
+        "%4s  %-13s %9s %9s %9s %9s %6s  %s"
+        % ("seq", "status", "mass g", "length mm", "width mm", "thick mm", "drops", "image")
+    )
     for r in rows:
-        print("%4d  %-13s %9s %9s %9s %9s %6d  %s" % (
-            r["seq"], r["status"], _f(r.get("mass_g")), _f(r.get("length_mm")),
-            _f(r.get("width_mm")), _f(r.get("thickness_mm")), r.get("drops") or 0,
-            r.get("image_path") or r.get("lost_reason") or ""))
+        print(
+            "%4d  %-13s %9s %9s %9s %9s %6d  %s"
+            % (
+                r["seq"],
+                r["status"],
+                _f(r.get("mass_g")),
+                _f(r.get("length_mm")),
+                _f(r.get("width_mm")),
+                _f(r.get("thickness_mm")),
+                r.get("drops") or 0,
+                r.get("image_path") or r.get("lost_reason") or "",
+            )
+        )
 
 
 def _f(v):

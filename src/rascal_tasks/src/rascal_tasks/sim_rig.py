@@ -5,6 +5,7 @@ simulator, the arm controller and the detector; and it stops all of them again.
 
     python3 -m rascal_tasks.sim_rig --scenario config/scenarios/small_3.yaml -- rascal run ...
 """
+
 import argparse
 import os
 import shutil
@@ -17,8 +18,11 @@ import time
 
 import yaml
 
-NODES = (("rascal_sim", "sim"), ("rascal_control", "arm_controller"),
-         ("rascal_perception", "sherd_detector"))
+NODES = (
+    ("rascal_sim", "sim"),
+    ("rascal_control", "arm_controller"),
+    ("rascal_perception", "sherd_detector"),
+)
 READY = ("/sim/ground_truth", "/rascal/arm/compute_ik", "/rascal/perception/detect")
 
 
@@ -61,12 +65,22 @@ class RosMaster:
         self.own_log_dir = log_dir is None
         self.log_dir = log_dir or tempfile.mkdtemp(prefix="rascal_roslog_")
         self.uri = "http://127.0.0.1:%d" % self.port
-        self.env = dict(os.environ, ROS_MASTER_URI=self.uri, ROS_LOG_DIR=self.log_dir,
-                        ROS_HOSTNAME="127.0.0.1", ROS_HOME=self.log_dir, PYTHONUNBUFFERED="1")
+        self.env = dict(
+            os.environ,
+            ROS_MASTER_URI=self.uri,
+            ROS_LOG_DIR=self.log_dir,
+            ROS_HOSTNAME="127.0.0.1",
+            ROS_HOME=self.log_dir,
+            PYTHONUNBUFFERED="1",
+        )
         self.env.pop("ROS_IP", None)
-        self.proc = subprocess.Popen(["roscore", "-p", str(self.port)], env=self.env,
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT,
-                                     start_new_session=True)
+        self.proc = subprocess.Popen(
+            ["roscore", "-p", str(self.port)],
+            env=self.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
         deadline = time.monotonic() + timeout
         while self.run(["rosparam", "get", "/run_id"], check=False).returncode != 0:
             if time.monotonic() > deadline or self.proc.poll() is not None:
@@ -76,8 +90,9 @@ class RosMaster:
 
     def run(self, cmd, check=True, timeout=60.0, **kw):
         """Run a command against this master and wait for it (rosparam, rosservice, ...)."""
-        return subprocess.run(cmd, env=self.env, capture_output=True, text=True, check=check,
-                              timeout=timeout, **kw)
+        return subprocess.run(
+            cmd, env=self.env, capture_output=True, text=True, check=check, timeout=timeout, **kw
+        )
 
     def stop(self):
         stop(self.proc)
@@ -88,8 +103,16 @@ class RosMaster:
 class SimRig:
     """The simulated rig. `env` talks to its master; `params` are set after the config."""
 
-    def __init__(self, scenario=None, params=None, master_env=None, log_dir=None,
-                 nodes=NODES, ready=READY, ws=None):
+    def __init__(
+        self,
+        scenario=None,
+        params=None,
+        master_env=None,
+        log_dir=None,
+        nodes=NODES,
+        ready=READY,
+        ws=None,
+    ):
         self.ws = ws or workspace()
         self.procs = []
         self.own_log_dir = log_dir is None
@@ -104,8 +127,15 @@ class SimRig:
         try:
             self.run(["rosparam", "load", os.path.join(self.ws, "config", "rascal.yaml")])
             self.set_param("/use_sim_time", True)
-            self.run(["rosparam", "set", "/robot_description", "-t", os.path.join(
-                self.ws, "src", "rascal_description", "urdf", "wx250s.urdf")])
+            self.run(
+                [
+                    "rosparam",
+                    "set",
+                    "/robot_description",
+                    "-t",
+                    os.path.join(self.ws, "src", "rascal_description", "urdf", "wx250s.urdf"),
+                ]
+            )
             if scenario:
                 self.set_param("/simulator/scenario", os.path.abspath(scenario))
             for key, value in (params or {}).items():
@@ -121,16 +151,36 @@ class SimRig:
     def _spawn(self, name, cmd):
         log = open(os.path.join(self.log_dir, name + ".out"), "w")
         self.logs[name] = log.name
-        return subprocess.Popen(cmd, env=self.env, stdout=log, stderr=subprocess.STDOUT,
-                                start_new_session=True, cwd=self.ws)
+        return subprocess.Popen(
+            cmd,
+            env=self.env,
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+            cwd=self.ws,
+        )
 
     def run(self, cmd, check=True, timeout=120.0, **kw):
-        return subprocess.run(cmd, env=self.env, capture_output=True, text=True, check=check,
-                              timeout=timeout, cwd=self.ws, **kw)
+        return subprocess.run(
+            cmd,
+            env=self.env,
+            capture_output=True,
+            text=True,
+            check=check,
+            timeout=timeout,
+            cwd=self.ws,
+            **kw,
+        )
 
     def set_param(self, key, value):
-        self.run(["rosparam", "set", key, yaml.safe_dump(value, default_flow_style=True)
-                  .strip().removesuffix("...").strip()])
+        self.run(
+            [
+                "rosparam",
+                "set",
+                key,
+                yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("...").strip(),
+            ]
+        )
 
     def wait_for_service(self, name, timeout=90.0):
         deadline = time.monotonic() + timeout
@@ -139,8 +189,10 @@ class SimRig:
                 return
             for p in self.procs:
                 if p.poll() is not None:
-                    raise RuntimeError("%s exited (%d) before %s came up:\n%s" % (
-                        p.args[-1], p.returncode, name, self.tail()))
+                    raise RuntimeError(
+                        "%s exited (%d) before %s came up:\n%s"
+                        % (p.args[-1], p.returncode, name, self.tail())
+                    )
             time.sleep(0.3)
         raise RuntimeError("service %s did not come up:\n%s" % (name, self.tail()))
 
@@ -155,8 +207,14 @@ class SimRig:
         """Start `rosrun rascal_tasks rascal ARGS...` against this rig (returns the Popen)."""
         popen.setdefault("stdout", subprocess.PIPE)
         popen.setdefault("stderr", subprocess.STDOUT)
-        proc = subprocess.Popen(["rosrun", "rascal_tasks", "rascal", *args], env=self.env,
-                                text=True, start_new_session=True, cwd=self.ws, **popen)
+        proc = subprocess.Popen(
+            ["rosrun", "rascal_tasks", "rascal", *args],
+            env=self.env,
+            text=True,
+            start_new_session=True,
+            cwd=self.ws,
+            **popen,
+        )
         self.procs.append(proc)
         return proc
 
@@ -178,12 +236,18 @@ class SimRig:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description="Start the simulated rig, run one command against "
-                                "it, stop everything.")
+    p = argparse.ArgumentParser(
+        description="Start the simulated rig, run one command against " "it, stop everything."
+    )
     p.add_argument("--scenario", help="scenario YAML (default: simulator.scenario of the config)")
     p.add_argument("--rtf", type=float, help="simulator real-time factor (0 = fast as possible)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=YAML",
-                   help="extra parameter, e.g. /archive/root=/tmp/archive")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=YAML",
+        help="extra parameter, e.g. /archive/root=/tmp/archive",
+    )
     p.add_argument("command", nargs=argparse.REMAINDER, help="-- command to run, e.g. rosrun ...")
     args = p.parse_args(argv)
     params = {}

@@ -4,16 +4,34 @@ No ROS here: the connection, logger and clock are passed in.
 
     from rascal_tasks.catalogue import Catalogue, ImageArchive, migrate
 """
+
 from .archive import ImageArchive
 from .catalogue import SOFTWARE_VERSION, Catalogue
 from .context_id import MAX_ID_LENGTH, validate_context_id, validate_site_id
-from .errors import (CatalogueError, ContextIdError, FieldError, MigrationError,
-                     StatusError)
+from .errors import CatalogueError, ContextIdError, FieldError, MigrationError, StatusError
 from .export import export_records, parse_csv, to_csv, to_json
 from .fields import COLUMN_TYPES, COLUMNS
 from .migrate import available, migrate, status
 
-__all__ = ['Catalogue', 'ImageArchive', 'SOFTWARE_VERSION', 'MAX_ID_LENGTH',
-           'validate_context_id', 'validate_site_id', 'CatalogueError', 'ContextIdError',
-           'FieldError', 'MigrationError', 'StatusError', 'export_records', 'parse_csv',
-           'to_csv', 'to_json', 'COLUMNS', 'COLUMN_TYPES', 'available', 'migrate', 'status']
+__all__ = [
+    "Catalogue",
+    "ImageArchive",
+    "SOFTWARE_VERSION",
+    "MAX_ID_LENGTH",
+    "validate_context_id",
+    "validate_site_id",
+    "CatalogueError",
+    "ContextIdError",
+    "FieldError",
+    "MigrationError",
+    "StatusError",
+    "export_records",
+    "parse_csv",
+    "to_csv",
+    "to_json",
+    "COLUMNS",
+    "COLUMN_TYPES",
+    "available",
+    "migrate",
+    "status",
+]

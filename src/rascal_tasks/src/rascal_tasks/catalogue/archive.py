@@ -7,6 +7,7 @@ temporary name in the same directory, flushed and fsync'ed, then renamed into pl
 (``os.replace`` is atomic on POSIX); the directory is fsync'ed after the rename. Only then
 are the path and hash handed to the database.
 """
+
 import datetime
 import hashlib
 import json
@@ -16,9 +17,9 @@ import tempfile
 from .context_id import validate_context_id
 from .errors import FieldError
 
-__all__ = ['ImageArchive', 'PNG_SIGNATURE']
+__all__ = ["ImageArchive", "PNG_SIGNATURE"]
 
-PNG_SIGNATURE = b'\x89PNG\r\n\x1a\n'
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _CHUNK = 1 << 20
 
 
@@ -42,16 +43,18 @@ class ImageArchive:
         """Where a sherd's image lives, relative to the root: ``<context>/<seq>.png``."""
         validate_context_id(context_id)
         if isinstance(seq, bool) or not isinstance(seq, int) or seq < 1:
-            raise FieldError('seq %r: must be the sherd\'s sequence number (an integer >= 1)'
-                             % (seq,))
-        return '%s/%d.png' % (context_id, seq)
+            raise FieldError(
+                "seq %r: must be the sherd's sequence number (an integer >= 1)" % (seq,)
+            )
+        return "%s/%d.png" % (context_id, seq)
 
     def path(self, relpath):
         """Absolute path of an archived file; refuses paths that leave the archive."""
         full = os.path.realpath(os.path.join(self.root, relpath))
         if os.path.commonpath([full, os.path.realpath(self.root)]) != os.path.realpath(self.root):
-            raise FieldError("image_path '%s': points outside the archive %s" % (relpath,
-                                                                                   self.root))
+            raise FieldError(
+                "image_path '%s': points outside the archive %s" % (relpath, self.root)
+            )
         return full
 
     def store(self, context_id, seq, image, record=None):
@@ -71,10 +74,10 @@ class ImageArchive:
     def write_sidecar(self, context_id, seq, record):
         """(Re)write ``<context>/<seq>.json`` atomically with ``record`` (the sherd's row)."""
         rel = self.relpath(context_id, seq)
-        final = self.path(rel)[:-4] + '.json'
+        final = self.path(rel)[:-4] + ".json"
         os.makedirs(os.path.dirname(final), exist_ok=True)
         side = dict(record, written_at=datetime.datetime.now(datetime.timezone.utc))
-        blob = json.dumps(side, default=_json_default, sort_keys=True, indent=1).encode() + b'\n'
+        blob = json.dumps(side, default=_json_default, sort_keys=True, indent=1).encode() + b"\n"
         self._write_atomic(final, iter([blob]))
         return final
 
@@ -82,8 +85,8 @@ class ImageArchive:
         """True if the archived file exists and has this SHA-256."""
         try:
             h = hashlib.sha256()
-            with open(self.path(relpath), 'rb') as f:
-                for block in iter(lambda: f.read(_CHUNK), b''):
+            with open(self.path(relpath), "rb") as f:
+                for block in iter(lambda: f.read(_CHUNK), b""):
                     h.update(block)
         except FileNotFoundError:
             return False
@@ -96,34 +99,38 @@ class ImageArchive:
             return
         if isinstance(image, (str, os.PathLike)):
             try:
-                f = open(image, 'rb')
+                f = open(image, "rb")
             except OSError as e:
                 raise FieldError("image '%s': cannot be read (%s)" % (image, e.strerror)) from None
             with f:
-                yield from iter(lambda: f.read(_CHUNK), b'')
+                yield from iter(lambda: f.read(_CHUNK), b"")
             return
-        raise FieldError('image: must be PNG bytes or the path of a PNG file, got %s'
-                         % type(image).__name__)
+        raise FieldError(
+            "image: must be PNG bytes or the path of a PNG file, got %s" % type(image).__name__
+        )
 
     def _write_atomic(self, final, chunks, check_png=False):
         directory = os.path.dirname(final)
-        fd, tmp = tempfile.mkstemp(prefix='.' + os.path.basename(final) + '.', suffix='.tmp',
-                                   dir=directory)
+        fd, tmp = tempfile.mkstemp(
+            prefix="." + os.path.basename(final) + ".", suffix=".tmp", dir=directory
+        )
         h = hashlib.sha256()
         try:
-            with os.fdopen(fd, 'wb') as f:
+            with os.fdopen(fd, "wb") as f:
                 total = 0
                 for block in chunks:
                     if not block:
                         continue
                     if check_png and total == 0 and not block.startswith(PNG_SIGNATURE):
-                        raise FieldError('image: not a PNG file (the archive keeps lossless '
-                                         'PNG only; save the capture as PNG)')
+                        raise FieldError(
+                            "image: not a PNG file (the archive keeps lossless "
+                            "PNG only; save the capture as PNG)"
+                        )
                     h.update(block)
                     f.write(block)
                     total += len(block)
                 if check_png and total == 0:
-                    raise FieldError('image: empty (the capture returned no data)')
+                    raise FieldError("image: empty (the capture returned no data)")
                 f.flush()
                 if self._fsync:
                     os.fsync(f.fileno())

@@ -1,7 +1,7 @@
 """Errors of the catalogue and the image archive. Messages are one line that names the field
 (or the record) and says what to do."""
 
-__all__ = ['CatalogueError', 'FieldError', 'ContextIdError', 'StatusError', 'MigrationError']
+__all__ = ["CatalogueError", "FieldError", "ContextIdError", "StatusError", "MigrationError"]
 
 
 class CatalogueError(Exception):

@@ -6,6 +6,7 @@ JSON: ``{"format", "version", "context": {...}, "columns": [...], "sherds": [{..
 numbers as numbers and missing values as null. ``parse_csv`` reads the CSV back into the
 same Python values (the round trip the tests check).
 """
+
 import csv
 import datetime
 import io
@@ -15,34 +16,41 @@ from .context_id import validate_context_id
 from .errors import FieldError
 from .fields import COLUMN_TYPES, COLUMNS
 
-__all__ = ['EXPORT_FORMAT', 'export_records', 'to_csv', 'to_json', 'parse_csv', 'json_default']
+__all__ = ["EXPORT_FORMAT", "export_records", "to_csv", "to_json", "parse_csv", "json_default"]
 
-EXPORT_FORMAT = 'rascal-catalogue-export'
+EXPORT_FORMAT = "rascal-catalogue-export"
 EXPORT_VERSION = 1
 
 _SELECT = (
     "SELECT s.context_id || '-' || s.seq AS find_id, c.site_id, s.context_id, s.seq, "
-    's.status::text AS status, mass_g, length_mm, width_mm, thickness_mm, colour_munsell, '
-    'colour_l, colour_a, colour_b, chart_delta_e00, px_per_cm, image_path, image_sha256, drops, '
-    'grasp_attempts, pickup_x_m, pickup_y_m, t_pick_s, t_weigh_s, t_photo_s, t_discard_s, '
-    't_locomotion_s, t_grasping_s, t_data_collection_s, t_perception_s, '
-    'lost_reason, notes, rig, software_version, config_hash, picked_at, weighed_at, '
-    'photographed_at, done_at, lost_at, updated_at '
-    'FROM sherds s JOIN contexts c USING (context_id) WHERE s.context_id = %s ORDER BY s.seq')
+    "s.status::text AS status, mass_g, length_mm, width_mm, thickness_mm, colour_munsell, "
+    "colour_l, colour_a, colour_b, chart_delta_e00, px_per_cm, image_path, image_sha256, drops, "
+    "grasp_attempts, pickup_x_m, pickup_y_m, t_pick_s, t_weigh_s, t_photo_s, t_discard_s, "
+    "t_locomotion_s, t_grasping_s, t_data_collection_s, t_perception_s, "
+    "lost_reason, notes, rig, software_version, config_hash, picked_at, weighed_at, "
+    "photographed_at, done_at, lost_at, updated_at "
+    "FROM sherds s JOIN contexts c USING (context_id) WHERE s.context_id = %s ORDER BY s.seq"
+)
 
 
 def export_records(conn, context_id):
     """``(context, records)``: the context's row and its sherds as dicts in export order."""
     validate_context_id(context_id)
     with conn, conn.cursor() as cur:
-        cur.execute('SELECT context_id, site_id, description, created_at FROM contexts '
-                    'WHERE context_id = %s', (context_id,))
+        cur.execute(
+            "SELECT context_id, site_id, description, created_at FROM contexts "
+            "WHERE context_id = %s",
+            (context_id,),
+        )
         ctx = cur.fetchone()
         if ctx is None:
-            raise FieldError("context id '%s': not in the catalogue (check the id; "
-                             '`rascal db status` shows the database in use)' % context_id)
-        context = dict(zip(('context_id', 'site_id', 'description', 'created_at'), ctx,
-                           strict=True))
+            raise FieldError(
+                "context id '%s': not in the catalogue (check the id; "
+                "`rascal db status` shows the database in use)" % context_id
+            )
+        context = dict(
+            zip(("context_id", "site_id", "description", "created_at"), ctx, strict=True)
+        )
         cur.execute(_SELECT, (context_id,))
         names = [d[0] for d in cur.description]
         assert names == [c[0] for c in COLUMNS], names
@@ -57,29 +65,33 @@ def _utc(ts):
 def json_default(value):
     if isinstance(value, datetime.datetime):
         return _utc(value)
-    raise TypeError('cannot export %r' % (value,))
+    raise TypeError("cannot export %r" % (value,))
 
 
 def to_json(context, records):
-    doc = {'format': EXPORT_FORMAT, 'version': EXPORT_VERSION, 'context': context,
-           'columns': [{'name': n, 'type': t, 'description': d} for n, t, d in COLUMNS],
-           'sherds': records}
-    return json.dumps(doc, default=json_default, indent=1, ensure_ascii=False) + '\n'
+    doc = {
+        "format": EXPORT_FORMAT,
+        "version": EXPORT_VERSION,
+        "context": context,
+        "columns": [{"name": n, "type": t, "description": d} for n, t, d in COLUMNS],
+        "sherds": records,
+    }
+    return json.dumps(doc, default=json_default, indent=1, ensure_ascii=False) + "\n"
 
 
 def _cell(kind, value):
     if value is None:
-        return ''
-    if kind == 'float':
+        return ""
+    if kind == "float":
         return repr(float(value))
-    if kind == 'timestamp':
+    if kind == "timestamp":
         return _utc(value)
     return str(value)
 
 
 def to_csv(records):
     out = io.StringIO()
-    w = csv.writer(out, lineterminator='\n')
+    w = csv.writer(out, lineterminator="\n")
     w.writerow([name for name, _, _ in COLUMNS])
     for rec in records:
         w.writerow([_cell(kind, rec[name]) for name, kind, _ in COLUMNS])
@@ -87,13 +99,13 @@ def to_csv(records):
 
 
 def _parse(kind, text):
-    if text == '':
+    if text == "":
         return None
-    if kind == 'int':
+    if kind == "int":
         return int(text)
-    if kind == 'float':
+    if kind == "float":
         return float(text)
-    if kind == 'timestamp':
+    if kind == "timestamp":
         return datetime.datetime.fromisoformat(text)
     return text
 

@@ -5,6 +5,7 @@ the preempt goes on to its normal outcome selection). Fixed: upstream hangs fore
 child returns ``None`` or when ``child_termination_cb`` raises; here both end the
 concurrence with an error once the siblings have been preempted and joined.
 """
+
 import copy
 import sys
 import threading
@@ -14,7 +15,7 @@ from .container import Container
 from .state import State
 from .user_data import Remapper
 
-__all__ = ['Concurrence']
+__all__ = ["Concurrence"]
 
 _POLL = 0.05  # [s] how often a waiting concurrence checks the shutdown hook
 
@@ -33,28 +34,39 @@ class Concurrence(Container):
     preempts every child still running.
     """
 
-    def __init__(self, outcomes, default_outcome, input_keys=(), output_keys=(),
-                 outcome_map=None, outcome_cb=None, child_termination_cb=None):
+    def __init__(
+        self,
+        outcomes,
+        default_outcome,
+        input_keys=(),
+        output_keys=(),
+        outcome_map=None,
+        outcome_cb=None,
+        child_termination_cb=None,
+    ):
         Container.__init__(self, outcomes, input_keys, output_keys)
         outcome_map = {} if outcome_map is None else outcome_map
         if not (default_outcome or outcome_map or outcome_cb):
             raise _smach().InvalidStateError(
-                'Concurrence requires an outcome policy: default_outcome, outcome_map or '
-                'outcome_cb.')
+                "Concurrence requires an outcome policy: default_outcome, outcome_map or "
+                "outcome_cb."
+            )
         registered = self.get_registered_outcomes()
         if not isinstance(default_outcome, str) or default_outcome not in registered:
             raise _smach().InvalidStateError(
                 "Concurrence default_outcome %r must be one of its outcomes: %s"
-                % (default_outcome, list(registered)))
+                % (default_outcome, list(registered))
+            )
         for container_outcome in outcome_map:
             if container_outcome not in registered:
                 raise _smach().InvalidStateError(
                     "Outcome map in Concurrence names outcome '%s', which is not one of its "
-                    'outcomes: %s' % (container_outcome, list(registered)))
+                    "outcomes: %s" % (container_outcome, list(registered))
+                )
         if outcome_cb is not None and not callable(outcome_cb):
-            raise _smach().InvalidStateError('Concurrence outcome_cb must be callable.')
+            raise _smach().InvalidStateError("Concurrence outcome_cb must be callable.")
         if child_termination_cb is not None and not callable(child_termination_cb):
-            raise _smach().InvalidStateError('Concurrence child_termination_cb must be callable.')
+            raise _smach().InvalidStateError("Concurrence child_termination_cb must be callable.")
         self._default_outcome = default_outcome
         self._outcome_map = outcome_map
         self._outcome_cb = outcome_cb
@@ -82,7 +94,7 @@ class Concurrence(Container):
     # --- execution ---
     def execute(self, parent_ud=None):
         if not self._states:
-            raise _smach().InvalidStateError('No states was added to concurrence')
+            raise _smach().InvalidStateError("No states was added to concurrence")
         self._copy_input_keys(parent_ud, self.userdata)
         with self._done_cond:
             self._child_outcomes = {label: None for label in self._states}
@@ -94,15 +106,23 @@ class Concurrence(Container):
             go = threading.Event()
             self._threads = {}
             for label in self._states:
-                t = threading.Thread(target=self._state_runner, args=(label, go),
-                                     name='concurrent_split:' + label, daemon=True)
+                t = threading.Thread(
+                    target=self._state_runner,
+                    args=(label, go),
+                    name="concurrent_split:" + label,
+                    daemon=True,
+                )
                 self._threads[label] = t
                 t.start()
             go.set()
 
             with self._done_cond:
-                while not (self._terminate or self._errors or self._preempt_requested
-                           or all(o is not None for o in self._child_outcomes.values())):
+                while not (
+                    self._terminate
+                    or self._errors
+                    or self._preempt_requested
+                    or all(o is not None for o in self._child_outcomes.values())
+                ):
                     if _smach().is_shutdown():
                         break
                     self._done_cond.wait(_POLL)
@@ -111,18 +131,21 @@ class Concurrence(Container):
                 try:
                     self._states[label].request_preempt()
                 except Exception:
-                    _smach().logerr("Failed to preempt concurrent state '%s': %s"
-                                    % (label, traceback.format_exc()))
+                    _smach().logerr(
+                        "Failed to preempt concurrent state '%s': %s"
+                        % (label, traceback.format_exc())
+                    )
             for t in self._threads.values():
                 while t.is_alive() and not _smach().is_shutdown():
                     t.join(_POLL)
 
             if self._errors:
                 kind, message = self._errors[0]
-                if kind == 'user':
+                if kind == "user":
                     raise _smach().InvalidUserCodeError(message)
                 raise _smach().InvalidStateError(
-                    'A concurrent state raised an exception during execution. ' + message)
+                    "A concurrent state raised an exception during execution. " + message
+                )
 
             if self._preempt_requested:
                 unserviced = [lb for lb, s in self._states.items() if s.preempt_requested()]
@@ -131,8 +154,10 @@ class Concurrence(Container):
                 else:
                     for label in unserviced:
                         self._states[label].recall_preempt()
-                    _smach().logwarn('Concurrence preempted, but these children did not '
-                                     'service the preempt: %s' % unserviced)
+                    _smach().logwarn(
+                        "Concurrence preempted, but these children did not "
+                        "service the preempt: %s" % unserviced
+                    )
 
             outcome = self._select_outcome()
             self.call_termination_cbs(list(self._states), outcome)
@@ -157,14 +182,17 @@ class Concurrence(Container):
             except Exception:
                 raise _smach().InvalidUserCodeError(
                     "Could not execute outcome callback '%s': %s"
-                    % (self._outcome_cb, traceback.format_exc())) from None
+                    % (self._outcome_cb, traceback.format_exc())
+                ) from None
             if isinstance(cb_outcome, str) and cb_outcome:
                 outcome = cb_outcome
-            elif cb_outcome is None or cb_outcome == '':
+            elif cb_outcome is None or cb_outcome == "":
                 _smach().logwarn("Outcome callback returned None; using outcome '%s'." % outcome)
             else:
-                _smach().logerr("Outcome callback returned a non-string %r; using outcome '%s'."
-                                % (cb_outcome, outcome))
+                _smach().logerr(
+                    "Outcome callback returned a non-string %r; using outcome '%s'."
+                    % (cb_outcome, outcome)
+                )
         return outcome
 
     def _state_runner(self, label, go):
@@ -172,18 +200,27 @@ class Concurrence(Container):
         state = self._states[label]
         self.call_transition_cbs()
         try:
-            outcome = state.execute(Remapper(self.userdata,
-                                             state.get_registered_input_keys(),
-                                             state.get_registered_output_keys(),
-                                             self._remappings[label]))
+            outcome = state.execute(
+                Remapper(
+                    self.userdata,
+                    state.get_registered_input_keys(),
+                    state.get_registered_output_keys(),
+                    self._remappings[label],
+                )
+            )
         except Exception:
-            self._fail('state', "State '%s' of type '%s' failed: %s"
-                       % (label, state, traceback.format_exc()))
+            self._fail(
+                "state",
+                "State '%s' of type '%s' failed: %s" % (label, state, traceback.format_exc()),
+            )
             return
         if outcome is None:
-            self._fail('state', "State '%s' of type '%s' returned None; it must return one of "
-                       'its registered outcomes %s' % (label, state,
-                                                      list(state.get_registered_outcomes())))
+            self._fail(
+                "state",
+                "State '%s' of type '%s' returned None; it must return one of "
+                "its registered outcomes %s"
+                % (label, state, list(state.get_registered_outcomes())),
+            )
             return
         with self._done_cond:
             self._child_outcomes[label] = outcome
@@ -194,8 +231,10 @@ class Concurrence(Container):
                 try:
                     terminate = self._child_termination_cb(self._child_outcomes)
                 except Exception:
-                    self._fail('user', "Could not execute child termination callback: %s"
-                               % traceback.format_exc())
+                    self._fail(
+                        "user",
+                        "Could not execute child termination callback: %s" % traceback.format_exc(),
+                    )
                     return
             if terminate:
                 self._terminate = True
@@ -230,8 +269,10 @@ class Concurrence(Container):
         """All children always start; only ``userdata`` is merged (upstream raises
         TypeError here on Python 3)."""
         if initial_states:
-            _smach().logwarn('Attempting to set initial state of a Concurrence; all of its '
-                             'states start together, so this is ignored.')
+            _smach().logwarn(
+                "Attempting to set initial state of a Concurrence; all of its "
+                "states start together, so this is ignored."
+            )
         if userdata is not None:
             self.userdata.update(userdata)
 
@@ -254,11 +295,17 @@ class Concurrence(Container):
                 if child_label not in self._states:
                     raise _smach().InvalidTransitionError(
                         "Outcome map of outcome '%s' names state '%s', which is not a child "
-                        'of this Concurrence (children: %s)'
-                        % (container_outcome, child_label, list(self._states)))
+                        "of this Concurrence (children: %s)"
+                        % (container_outcome, child_label, list(self._states))
+                    )
                 if child_outcome not in self._states[child_label].get_registered_outcomes():
                     raise _smach().InvalidTransitionError(
                         "Outcome map of outcome '%s' expects outcome '%s' from state '%s', "
-                        'which only has outcomes %s'
-                        % (container_outcome, child_outcome, child_label,
-                           list(self._states[child_label].get_registered_outcomes())))
+                        "which only has outcomes %s"
+                        % (
+                            container_outcome,
+                            child_outcome,
+                            child_label,
+                            list(self._states[child_label].get_registered_outcomes()),
+                        )
+                    )

@@ -6,6 +6,7 @@ exception inside the ``with`` block closes the container before it propagates, s
 construction lock is never left held (upstream leaves it held and every other thread that
 opens a container then blocks forever).
 """
+
 import contextlib
 import sys
 import threading
@@ -14,7 +15,7 @@ import traceback
 from .state import State
 from .user_data import UserData
 
-__all__ = ['Container']
+__all__ = ["Container"]
 
 
 def _smach():
@@ -65,8 +66,9 @@ class Container(State):
             try:
                 ud[key] = parent_ud[key]
             except KeyError:
-                _smach().logwarn("Attempting to copy input key '%s', but this key does not "
-                                 "exist." % key)
+                _smach().logwarn(
+                    "Attempting to copy input key '%s', but this key does not " "exist." % key
+                )
 
     def _copy_output_keys(self, ud, parent_ud):
         if parent_ud is None:
@@ -75,8 +77,9 @@ class Container(State):
             if key in ud:
                 parent_ud[key] = ud[key]
             else:
-                _smach().logwarn("Attempting to copy output key '%s', but this key does not "
-                                 "exist." % key)
+                _smach().logwarn(
+                    "Attempting to copy output key '%s', but this key does not " "exist." % key
+                )
 
     # --- callbacks ---
     def register_start_cb(self, start_cb, cb_args=()):
@@ -97,16 +100,16 @@ class Container(State):
             for cb, cb_args in cbs:
                 cb(self.userdata, *(list(args) + cb_args))
         except Exception:
-            _smach().logerr('Could not execute %s callback: %s' % (kind, traceback.format_exc()))
+            _smach().logerr("Could not execute %s callback: %s" % (kind, traceback.format_exc()))
 
     def call_start_cbs(self):
-        self._call_cbs('start', self._start_cbs, [self.get_initial_states()])
+        self._call_cbs("start", self._start_cbs, [self.get_initial_states()])
 
     def call_transition_cbs(self):
-        self._call_cbs('transition', self._transition_cbs, [self.get_active_states()])
+        self._call_cbs("transition", self._transition_cbs, [self.get_active_states()])
 
     def call_termination_cbs(self, terminal_states, outcome):
-        self._call_cbs('termination', self._termination_cbs, [terminal_states, outcome])
+        self._call_cbs("termination", self._termination_cbs, [terminal_states, outcome])
 
     # --- construction context ---
     def open(self):
@@ -119,12 +122,13 @@ class Container(State):
         """Close the container and check it (a failed check is logged, as in smach)."""
         if not Container._construction_stack or Container._construction_stack[-1] is not self:
             raise _smach().InvalidStateError(
-                'Attempting to close a container that is not currently open.')
+                "Attempting to close a container that is not currently open."
+            )
         self._pop_construction()
         try:
             self.check_consistency()
         except (_smach().InvalidStateError, _smach().InvalidTransitionError):
-            _smach().logerr('Container consistency check failed.')
+            _smach().logerr("Container consistency check failed.")
 
     def _pop_construction(self):
         Container._construction_stack.pop()
@@ -134,9 +138,9 @@ class Container(State):
     def is_opened(self):
         return bool(Container._construction_stack) and Container._construction_stack[-1] is self
 
-    def assert_opened(self, msg=''):
+    def assert_opened(self, msg=""):
         if not self.is_opened():
-            raise _smach().InvalidConstructionError(msg or 'The container is not open.')
+            raise _smach().InvalidConstructionError(msg or "The container is not open.")
 
     def __enter__(self):
         return self.open()  # None, as in smach: the idiom is `with sm:`
@@ -147,10 +151,11 @@ class Container(State):
             return False
         if Container._construction_stack and Container._construction_stack[-1] is self:
             self._pop_construction()
-        if not issubclass(exc_type, (_smach().InvalidStateError,
-                                     _smach().InvalidTransitionError)):
-            _smach().logerr('Error raised during SMACH container construction: %s'
-                            % ''.join(traceback.format_exception(exc_type, exc_val, exc_tb)))
+        if not issubclass(exc_type, (_smach().InvalidStateError, _smach().InvalidTransitionError)):
+            _smach().logerr(
+                "Error raised during SMACH container construction: %s"
+                % "".join(traceback.format_exception(exc_type, exc_val, exc_tb))
+            )
         return False
 
     @contextlib.contextmanager
@@ -170,11 +175,13 @@ class Container(State):
     def _currently_opened_container(cls):
         if not Container._construction_stack:
             raise _smach().InvalidStateError(
-                'Attempting to access the currently opened container, but no container is '
-                "open (use 'with sm:' around the add calls).")
+                "Attempting to access the currently opened container, but no container is "
+                "open (use 'with sm:' around the add calls)."
+            )
         top = Container._construction_stack[-1]
         if not isinstance(top, cls):
             raise _smach().InvalidStateError(
                 "Attempting to call a %s construction method while a %s is open."
-                % (cls.__name__, type(top).__name__))
+                % (cls.__name__, type(top).__name__)
+            )
         return top

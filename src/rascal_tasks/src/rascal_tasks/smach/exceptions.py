@@ -3,10 +3,16 @@
 Constructing any of them logs one ERROR line ``<ClassName>: <message>`` through the
 package's current error logger, as smach does.
 """
+
 import sys
 
-__all__ = ['SmachError', 'InvalidTransitionError', 'InvalidStateError',
-           'InvalidUserCodeError', 'InvalidConstructionError']
+__all__ = [
+    "SmachError",
+    "InvalidTransitionError",
+    "InvalidStateError",
+    "InvalidUserCodeError",
+    "InvalidConstructionError",
+]
 
 
 class SmachError(Exception):
@@ -14,7 +20,7 @@ class SmachError(Exception):
 
     def __init__(self, message):
         super().__init__(message)
-        sys.modules[__package__].logerr('%s: %s' % (type(self).__name__, message))
+        sys.modules[__package__].logerr("%s: %s" % (type(self).__name__, message))
 
 
 class InvalidTransitionError(SmachError):

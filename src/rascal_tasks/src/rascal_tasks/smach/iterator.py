@@ -1,11 +1,12 @@
 """``Iterator``: runs one contained state once per item of an iterable."""
+
 import sys
 import traceback
 
 from .container import Container
 from .state import State
 
-__all__ = ['Iterator']
+__all__ = ["Iterator"]
 
 
 def _smach():
@@ -20,8 +21,15 @@ class Iterator(Container):
     outcome when that is a break outcome or when the Iterator is preempted.
     """
 
-    def __init__(self, outcomes, input_keys, output_keys, it=(), it_label='it_data',
-                 exhausted_outcome='exhausted'):
+    def __init__(
+        self,
+        outcomes,
+        input_keys,
+        output_keys,
+        it=(),
+        it_label="it_data",
+        exhausted_outcome="exhausted",
+    ):
         outcomes = list(outcomes)
         if exhausted_outcome not in outcomes:
             outcomes.append(exhausted_outcome)
@@ -38,23 +46,26 @@ class Iterator(Container):
 
     # --- construction ---
     @staticmethod
-    def set_iteritems(it, it_label='it_data'):
+    def set_iteritems(it, it_label="it_data"):
         """Set the items (an iterable, or a callable returning one per execution)."""
         self = Iterator._currently_opened_container()
         self._items = it
         self._items_label = it_label
 
     @staticmethod
-    def set_contained_state(label, state, loop_outcomes=(), break_outcomes=(),
-                            final_outcome_map=None):
+    def set_contained_state(
+        label, state, loop_outcomes=(), break_outcomes=(), final_outcome_map=None
+    ):
         """Set the state to iterate. With ``break_outcomes`` every other outcome loops;
         otherwise every outcome not in ``loop_outcomes`` breaks."""
         self = Iterator._currently_opened_container()
         outcomes = state.get_registered_outcomes()
         if break_outcomes:
             if loop_outcomes:
-                _smach().logwarn('Iterator: both loop_outcomes and break_outcomes were given; '
-                                 'break_outcomes wins.')
+                _smach().logwarn(
+                    "Iterator: both loop_outcomes and break_outcomes were given; "
+                    "break_outcomes wins."
+                )
             self._break_outcomes = list(break_outcomes)
             self._loop_outcomes = [o for o in outcomes if o not in break_outcomes]
         else:
@@ -67,8 +78,9 @@ class Iterator(Container):
     # --- execution ---
     def execute(self, parent_ud=None):
         if self._state is None:
-            raise _smach().InvalidStateError('Iterator has no contained state: call '
-                                             'set_contained_state inside "with it:".')
+            raise _smach().InvalidStateError(
+                "Iterator has no contained state: call " 'set_contained_state inside "with it:".'
+            )
         self._is_running = True
         try:
             self._copy_input_keys(parent_ud, self.userdata)
@@ -93,13 +105,15 @@ class Iterator(Container):
                 except Exception:
                     raise _smach().InvalidUserCodeError(
                         "Could not execute Iterator state '%s' of type '%s': %s"
-                        % (self._state_label, self._state, traceback.format_exc())) from None
+                        % (self._state_label, self._state, traceback.format_exc())
+                    ) from None
                 if self._preempt_requested:
                     self.service_preempt()
                     outcome = state_outcome
                     break
-                if (state_outcome in self._break_outcomes
-                        or (self._loop_outcomes and state_outcome not in self._loop_outcomes)):
+                if state_outcome in self._break_outcomes or (
+                    self._loop_outcomes and state_outcome not in self._loop_outcomes
+                ):
                     outcome = state_outcome
                     break
                 self.call_transition_cbs()
@@ -122,8 +136,9 @@ class Iterator(Container):
 
     def __getitem__(self, key):
         if self._state is None or key != self._state_label:
-            _smach().logwarn("Iterator has no state labelled '%s' (it contains '%s')."
-                             % (key, self._state_label))
+            _smach().logwarn(
+                "Iterator has no state labelled '%s' (it contains '%s')." % (key, self._state_label)
+            )
             raise KeyError(key)
         return self._state
 
@@ -132,8 +147,10 @@ class Iterator(Container):
             initial_states = [initial_states]
         for label in initial_states or []:
             if label != self._state_label:
-                _smach().logwarn("Iterator cannot start at '%s': its only state is '%s'."
-                                 % (label, self._state_label))
+                _smach().logwarn(
+                    "Iterator cannot start at '%s': its only state is '%s'."
+                    % (label, self._state_label)
+                )
                 raise KeyError(label)
         if userdata is not None:
             self.userdata.update(userdata)
@@ -146,8 +163,9 @@ class Iterator(Container):
 
     def get_internal_edges(self):
         edges = [[o, self._state_label, self._state_label] for o in self._loop_outcomes]
-        edges += [(o, self._state_label, self._final_outcome_map.get(o))
-                  for o in self._break_outcomes]
+        edges += [
+            (o, self._state_label, self._final_outcome_map.get(o)) for o in self._break_outcomes
+        ]
         return edges
 
     def check_consistency(self):

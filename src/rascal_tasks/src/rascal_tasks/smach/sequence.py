@@ -1,9 +1,10 @@
 """``Sequence``: a StateMachine whose states are linked in the order they are added."""
+
 import sys
 
 from .state_machine import StateMachine
 
-__all__ = ['Sequence']
+__all__ = ["Sequence"]
 
 
 class Sequence(StateMachine):
@@ -23,11 +24,12 @@ class Sequence(StateMachine):
         if label in self._states:
             raise sys.modules[__package__].InvalidStateError(
                 "Attempting to add state with label '%s' to sequence, but this label is "
-                'already being used.' % label)
+                "already being used." % label
+            )
         previous = self._last_added_seq_label
         if previous is not None:
             prev_transitions = self._transitions[previous]
-            if prev_transitions.get(self._connector_outcome) in (None, ''):
+            if prev_transitions.get(self._connector_outcome) in (None, ""):
                 prev_transitions[self._connector_outcome] = label
         StateMachine.add(label, state, transitions, remapping)
         self._last_added_seq_label = label

@@ -1,9 +1,10 @@
 """``State`` and ``CBState``: the leaves of a state machine."""
+
 import sys
 
 from .util import has_smach_interface
 
-__all__ = ['State', 'CBState']
+__all__ = ["State", "CBState"]
 
 
 class State:
@@ -69,12 +70,14 @@ class CBState(State):
     ones given here.
     """
 
-    def __init__(self, cb, cb_args=(), cb_kwargs=None, outcomes=(), input_keys=(),
-                 output_keys=(), io_keys=()):
+    def __init__(
+        self, cb, cb_args=(), cb_kwargs=None, outcomes=(), input_keys=(), output_keys=(), io_keys=()
+    ):
         State.__init__(self, outcomes, input_keys, output_keys, io_keys)
         if not callable(cb):
             raise sys.modules[__package__].InvalidStateError(
-                'CBState: cb must be callable, got %r' % (cb,))
+                "CBState: cb must be callable, got %r" % (cb,)
+            )
         self._cb = cb
         self._cb_args = list(cb_args)
         self._cb_kwargs = dict(cb_kwargs or {})

@@ -5,11 +5,12 @@ missing key, ``_data`` as the storage dict) but guards it with one lock per inst
 of one lock per key, so a userdata that was touched by attribute can still be pickled or
 deep-copied (upstream raises TypeError: cannot pickle '_thread.lock').
 """
+
 import copy
 import sys
 import threading
 
-__all__ = ['UserData', 'Remapper', 'Const', 'get_const']
+__all__ = ["UserData", "Remapper", "Const", "get_const"]
 
 
 def _smach():
@@ -20,16 +21,16 @@ class UserData:
     """A dict-like store that also allows ``ud.key`` access."""
 
     def __init__(self):
-        object.__setattr__(self, '_data', {})
-        object.__setattr__(self, '_lock', threading.RLock())
+        object.__setattr__(self, "_data", {})
+        object.__setattr__(self, "_lock", threading.RLock())
 
     # --- pickling / copying: the lock is not state ---
     def __getstate__(self):
-        return {'_data': self._data}
+        return {"_data": self._data}
 
     def __setstate__(self, state):
-        object.__setattr__(self, '_data', state['_data'])
-        object.__setattr__(self, '_lock', threading.RLock())
+        object.__setattr__(self, "_data", state["_data"])
+        object.__setattr__(self, "_lock", threading.RLock())
 
     # --- dict-like API ---
     def keys(self):
@@ -43,8 +44,10 @@ class UserData:
     def __getitem__(self, key):
         with self._lock:
             if key not in self._data:
-                _smach().logerr("Userdata key '%s' not available. Available keys are: %s"
-                                % (key, list(self._data.keys())))
+                _smach().logerr(
+                    "Userdata key '%s' not available. Available keys are: %s"
+                    % (key, list(self._data.keys()))
+                )
                 raise KeyError(key)
             return self._data[key]
 
@@ -73,18 +76,18 @@ class UserData:
 
     # --- attribute access ---
     def __getattr__(self, name):
-        if name.startswith('_'):
+        if name.startswith("_"):
             raise AttributeError(name)
         return self[name]
 
     def __setattr__(self, name, value):
-        if name.startswith('_'):
+        if name.startswith("_"):
             object.__setattr__(self, name, value)
         else:
             self[name] = value
 
     def __repr__(self):
-        return 'UserData(%r)' % (self._data,)
+        return "UserData(%r)" % (self._data,)
 
 
 class Remapper:
@@ -95,11 +98,11 @@ class Remapper:
     """
 
     def __init__(self, ud, input_keys=(), output_keys=(), remapping=None):
-        object.__setattr__(self, '_ud', ud)
-        object.__setattr__(self, '_input', set(input_keys or ()))
-        object.__setattr__(self, '_output', set(output_keys or ()))
+        object.__setattr__(self, "_ud", ud)
+        object.__setattr__(self, "_input", set(input_keys or ()))
+        object.__setattr__(self, "_output", set(output_keys or ()))
         # smach_ros passes a list ([]) as the remapping; accept any empty value
-        object.__setattr__(self, '_map', dict(remapping) if remapping else {})
+        object.__setattr__(self, "_map", dict(remapping) if remapping else {})
 
     def _remap(self, key):
         return self._map.get(key, key)
@@ -109,7 +112,8 @@ class Remapper:
             raise _smach().InvalidUserCodeError(
                 "Reading from SMACH userdata key '%s' but the only keys that were declared as "
                 "input to this state were: %s. This key needs to be declared as input to this "
-                "state." % (key, sorted(self._input)))
+                "state." % (key, sorted(self._input))
+            )
         value = self._ud[self._remap(key)]
         if key not in self._output:
             return get_const(value)
@@ -120,17 +124,18 @@ class Remapper:
             _smach().logerr(
                 "Writing to SMACH userdata key '%s' but the only keys that were declared as "
                 "output from this state were: %s. The write is ignored."
-                % (key, sorted(self._output)))
+                % (key, sorted(self._output))
+            )
             return
         self._ud[self._remap(key)] = item
 
     def __getattr__(self, name):
-        if name.startswith('_'):
+        if name.startswith("_"):
             raise AttributeError(name)
         return self[name]
 
     def __setattr__(self, name, value):
-        if name.startswith('_'):
+        if name.startswith("_"):
             object.__setattr__(self, name, value)
         else:
             self[name] = value
@@ -150,13 +155,16 @@ class Remapper:
         self._ud.update(other_userdata)
 
     def __repr__(self):
-        return 'Remapper(in=%s, out=%s, map=%s)' % (sorted(self._input), sorted(self._output),
-                                                    self._map)
+        return "Remapper(in=%s, out=%s, map=%s)" % (
+            sorted(self._input),
+            sorted(self._output),
+            self._map,
+        )
 
 
 def get_const(obj):
     """Wrap objects with attributes in ``Const``; plain values pass through unchanged."""
-    if hasattr(obj, '__dict__') and not callable(obj) and not isinstance(obj, Const):
+    if hasattr(obj, "__dict__") and not callable(obj) and not isinstance(obj, Const):
         return Const(obj)
     return obj
 
@@ -171,7 +179,7 @@ class Const:
     """
 
     def __init__(self, obj):
-        object.__setattr__(self, '_Const__obj', obj)
+        object.__setattr__(self, "_Const__obj", obj)
 
     def __getattr__(self, name):
         return get_const(getattr(self.__obj, name))
@@ -180,13 +188,17 @@ class Const:
         return get_const(self.__obj[key])
 
     def __setattr__(self, name, value):
-        raise TypeError("'%s' is an input-only userdata value: it cannot be changed (attribute "
-                        "'%s'); declare the key as output or io to modify it"
-                        % (type(self.__obj).__name__, name))
+        raise TypeError(
+            "'%s' is an input-only userdata value: it cannot be changed (attribute "
+            "'%s'); declare the key as output or io to modify it"
+            % (type(self.__obj).__name__, name)
+        )
 
     def __delattr__(self, name):
-        raise TypeError("'%s' is an input-only userdata value: attribute '%s' cannot be "
-                        "deleted" % (type(self.__obj).__name__, name))
+        raise TypeError(
+            "'%s' is an input-only userdata value: attribute '%s' cannot be "
+            "deleted" % (type(self.__obj).__name__, name)
+        )
 
     def __setitem__(self, key, value):
         raise TypeError("input-only userdata value: item %r cannot be changed" % (key,))
@@ -203,4 +215,4 @@ class Const:
         return hash(self.__obj)
 
     def __repr__(self):
-        return 'Const(%r)' % (self.__obj,)
+        return "Const(%r)" % (self.__obj,)

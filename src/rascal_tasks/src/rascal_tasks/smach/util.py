@@ -1,9 +1,15 @@
 """Callback interfaces and the shutdown hook of the SMACH-compatible core."""
+
 import functools
 import sys
 
-__all__ = ['is_shutdown', 'set_shutdown_check', 'has_smach_interface', 'CBInterface',
-           'cb_interface']
+__all__ = [
+    "is_shutdown",
+    "set_shutdown_check",
+    "has_smach_interface",
+    "CBInterface",
+    "cb_interface",
+]
 
 
 def is_shutdown():
@@ -14,16 +20,18 @@ def is_shutdown():
 def set_shutdown_check(cb):
     """Replace ``is_shutdown`` for the whole core (smach_ros passes rospy.is_shutdown)."""
     if not callable(cb):
-        raise TypeError('set_shutdown_check: the check must be callable, got %r' % (cb,))
+        raise TypeError("set_shutdown_check: the check must be callable, got %r" % (cb,))
     for module in (sys.modules[__package__], sys.modules[__name__]):
         module.is_shutdown = cb
 
 
 def has_smach_interface(obj):
     """True if ``obj`` declares outcomes and userdata keys like a State or CBInterface."""
-    return (hasattr(obj, 'get_registered_input_keys')
-            and hasattr(obj, 'get_registered_output_keys')
-            and hasattr(obj, 'get_registered_outcomes'))
+    return (
+        hasattr(obj, "get_registered_input_keys")
+        and hasattr(obj, "get_registered_output_keys")
+        and hasattr(obj, "get_registered_outcomes")
+    )
 
 
 class CBInterface:
@@ -55,6 +63,8 @@ class CBInterface:
 
 def cb_interface(outcomes=None, input_keys=None, output_keys=None):
     """Decorator factory: ``@cb_interface(outcomes=[...], input_keys=[...])``."""
+
     def decorator(cb):
         return CBInterface(cb, outcomes, input_keys, output_keys)
+
     return decorator
