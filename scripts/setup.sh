@@ -20,7 +20,7 @@ APT_PACKAGES=(
   ros-visualization-msgs libvisualization-msgs-dev python3-visualization-msgs
   ros-actionlib-msgs libactionlib-msgs-dev python3-actionlib-msgs libactionlib-dev python3-actionlib
   ros-tf2-msgs libtf2-msgs-dev python3-tf2-msgs libtf2-ros-dev python3-tf2-ros
-  libtf2-geometry-msgs-dev libtf2-sensor-msgs-dev libtf2-eigen-dev ros-rosgraph-msgs
+  libtf2-geometry-msgs-dev libtf2-sensor-msgs-dev libtf2-eigen-dev libtf2-kdl-dev ros-rosgraph-msgs
   ros-robot-state-publisher rviz
   # kinematics, robot model
   liborocos-kdl-dev libkdl-parser-dev python3-pykdl liburdfdom-dev liburdfdom-tools libeigen3-dev

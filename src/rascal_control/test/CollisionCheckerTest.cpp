@@ -5,16 +5,18 @@
 #include "TestModel.hpp"
 #include "rascal_control/CollisionChecker.hpp"
 #include "rascal_control/TrajectoryPlanner.hpp"
+#include "rascal_workcell/GripperGeometry.hpp"
+#include "rascal_workcell/Parameters.hpp"
+#include "rascal_workcell/Workcell.hpp"
 
 using namespace rascal_control;
 
 namespace {
 
-// The station fixtures of config/rascal.yaml.
+// The station fixtures of config/rascal.yaml, as the controller gets them: the workcell's boxes.
 void addStations(CollisionChecker& checker) {
-  checker.addFixture({"camera stand", KDL::Vector(0.50, -0.30, 0.30), KDL::Vector(0.04, 0.04, 0.60), false, {}});
-  checker.addOpenBox("discard box", 0.02, -0.31, 0.14, 0.13, 0.04, 0.004);
-  checker.addFixture({"scale", KDL::Vector(0.30, 0.0, 0.0125), KDL::Vector(0.13, 0.13, 0.025), true, {}});
+  const auto params = rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "arm_controller");
+  checker.addFixtures(rascal_workcell::Workcell::fromParameters(params).collisionBoxes());
 }
 
 }  // namespace
@@ -50,6 +52,23 @@ TEST(CollisionChecker, TableAndFixtures) {
   hit = checker.check(r.joints);
   ASSERT_TRUE(hit);
   EXPECT_NE(hit->fixture.find("discard"), std::string::npos);
+}
+
+TEST(CollisionChecker, FingertipsMayTouchTheScalePlatformButNotItsHousing) {
+  CollisionChecker checker(testModel());
+  addStations(checker);
+  IkSolver ik(testModel());
+  const double tips = rascal_workcell::GripperGeometry::fromPackageUrdf().fingertip_offset;
+  // config/rascal.yaml: the scale at (0.30, 0), platform 0.13 m wide, its top 0.025 m high.
+  IkResult r = ik.solve(IkSolver::topDown(0.30, 0.0, 0.025 + tips - 0.001, 0.0), JointVector{});
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_FALSE(checker.check(r.joints)) << checker.check(r.joints)->fixture;
+  // Beside the platform, down to the housing's top (0.015 m, 15 mm wider than the platform).
+  r = ik.solve(IkSolver::topDown(0.30, 0.0725, 0.012 + tips, M_PI / 2.0), JointVector{});
+  ASSERT_TRUE(r.ok()) << r.message;
+  const auto hit = checker.check(r.joints);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->fixture, "scale housing");
 }
 
 TEST(CollisionChecker, MoveThroughTheCameraStandIsRefused) {

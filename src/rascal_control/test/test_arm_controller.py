@@ -1,10 +1,13 @@
 """Wiring tests of the arm_controller node (a master on a free port, nodes started with rosrun).
 
-Without a driver: parameter errors, the IK/FK services, goals failing cleanly.
+Without a driver: parameter errors, the IK/FK services, FK, TF and the gripper state from a
+published /joint_states, goals failing cleanly.
 Against the simulator (`rosrun rascal_sim sim`, skipped until rascal_sim is built): a pose goal
 arrives within 2 mm, an unreachable goal returns UNREACHABLE within 1 s without moving the arm,
-a cancelled move stops, and the gripper reports held on a sherd and not held on nothing.
+a cancelled move stops, and the gripper reports held on a sherd and not held on nothing (in its
+close results and on /rascal/gripper/state).
 """
+
 import json
 import math
 import os
@@ -22,8 +25,12 @@ CLIENT = os.path.join(HERE, "wiring_client.py")
 
 def built(package, executable):
     try:
-        out = subprocess.run(["catkin_find", "--first-only", package, executable],
-                             capture_output=True, text=True, timeout=30)
+        out = subprocess.run(
+            ["catkin_find", "--first-only", package, executable],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
     except (OSError, subprocess.TimeoutExpired):
         return False
     return out.returncode == 0 and bool(out.stdout.strip())
@@ -31,10 +38,12 @@ def built(package, executable):
 
 requires_controller = pytest.mark.skipif(
     not built("rascal_control", "arm_controller"),
-    reason="arm_controller not built (build the workspace and source devel/setup.bash)")
+    reason="arm_controller not built (build the workspace and source devel/setup.bash)",
+)
 requires_sim = pytest.mark.skipif(
     not built("rascal_sim", "sim"),
-    reason="rascal_sim is not built yet; these run against `rosrun rascal_sim sim`")
+    reason="rascal_sim is not built yet; these run against `rosrun rascal_sim sim`",
+)
 
 
 def wait_for(master, what, name, timeout=30.0):
@@ -50,6 +59,7 @@ def wait_for(master, what, name, timeout=30.0):
 def call(master, service, request):
     out = master.run(["rosservice", "call", service, request], check=True)
     import yaml
+
     return yaml.safe_load(out.stdout)
 
 
@@ -59,31 +69,44 @@ def start_controller(ros_master, rosrun):
     return proc
 
 
+def fatal_line(rosrun):
+    """Starts arm_controller, expects it to stop; its one FATAL line."""
+    proc = rosrun("rascal_control", "arm_controller")
+    out, _ = proc.communicate(timeout=30)
+    assert proc.returncode != 0, out
+    lines = [line for line in out.splitlines() if "FATAL" in line]
+    assert len(lines) == 1, out
+    return lines[0]
+
+
 @requires_controller
 def test_bad_parameter_names_the_key(ros_master, rosrun):
     ros_master.run(["rosparam", "load", CONFIG])
     ros_master.run(["rosparam", "set", "/arm/named_poses/home", "[0.0, 0.0]"])
-    proc = rosrun("rascal_control", "arm_controller")
-    out, _ = proc.communicate(timeout=30)
-    assert proc.returncode != 0
-    lines = [line for line in out.splitlines() if "FATAL" in line]
-    assert len(lines) == 1 and "/arm/named_poses/home" in lines[0], out
+    assert "arm.named_poses.home: expected 6 joint angles" in fatal_line(rosrun)
+
+
+@requires_controller
+def test_named_pose_outside_the_joint_limits_names_the_key(ros_master, rosrun):
+    ros_master.run(["rosparam", "load", CONFIG])
+    ros_master.run(["rosparam", "set", "/arm/named_poses/tuck", "[0.0, 0.0, 3.0, 0.0, 0.0, 0.0]"])
+    line = fatal_line(rosrun)
+    assert "arm.named_poses.tuck: expected every joint within its URDF limits (elbow" in line
 
 
 @requires_controller
 def test_missing_config_names_the_key(ros_master, rosrun):
-    proc = rosrun("rascal_control", "arm_controller")
-    out, _ = proc.communicate(timeout=30)
-    assert proc.returncode != 0 and "/arm/named_poses" in out, out
+    assert "rosparam load config/rascal.yaml" in fatal_line(rosrun)
+    ros_master.run(["rosparam", "load", CONFIG])
+    ros_master.run(["rosparam", "delete", "/arm/named_poses"])
+    assert "arm.named_poses: missing" in fatal_line(rosrun)
 
 
 @requires_controller
 def test_bad_fixture_names_the_key(ros_master, rosrun):
     ros_master.run(["rosparam", "load", CONFIG])
     ros_master.run(["rosparam", "set", "/stations/camera/stand/height", "-1"])
-    proc = rosrun("rascal_control", "arm_controller")
-    out, _ = proc.communicate(timeout=30)
-    assert proc.returncode != 0 and "/stations/camera/stand/height" in out, out
+    assert "stations.camera.stand.height: expected" in fatal_line(rosrun)
 
 
 @requires_controller
@@ -94,32 +117,49 @@ def test_services_without_a_driver(ros_master, rosrun):
     assert fk["success"]
     p = fk["pose"]["pose"]["position"]
     assert (p["x"], p["y"], p["z"]) == pytest.approx((0.458325, 0.0, 0.36065), abs=1e-9)
-    cam = call(ros_master, "/rascal/arm/compute_fk",
-               "{joints: [0, 0, 0, 0, 0, 0], link: camera_color_optical_frame}")
+    cam = call(
+        ros_master,
+        "/rascal/arm/compute_fk",
+        "{joints: [0, 0, 0, 0, 0, 0], link: camera_color_optical_frame}",
+    )
     assert cam["success"] and cam["pose"]["pose"]["position"]["z"] == pytest.approx(0.41565)
     bad = call(ros_master, "/rascal/arm/compute_fk", "{joints: [0, 0], link: ''}")
     assert not bad["success"] and "expected 6" in bad["message"]
     # A top-down pose: the solution reaches it.
     s = math.sqrt(0.5)
-    ik = call(ros_master, "/rascal/arm/compute_ik",
-              "{pose: {header: {frame_id: base_link}, pose: {position: {x: 0.3, y: 0.1, z: 0.1}, "
-              "orientation: {x: 0, y: %r, z: 0, w: %r}}}, seed: [0, 0, 0, 0, 0, 0]}" % (s, s))
+    ik = call(
+        ros_master,
+        "/rascal/arm/compute_ik",
+        "{pose: {header: {frame_id: base_link}, pose: {position: {x: 0.3, y: 0.1, z: 0.1}, "
+        "orientation: {x: 0, y: %r, z: 0, w: %r}}}, seed: [0, 0, 0, 0, 0, 0]}" % (s, s),
+    )
     assert ik["code"] == 0, ik["message"]
     back = call(ros_master, "/rascal/arm/compute_fk", "{joints: %s, link: ''}" % ik["joints"])
     p = back["pose"]["pose"]["position"]
     assert (p["x"], p["y"], p["z"]) == pytest.approx((0.3, 0.1, 0.1), abs=1e-6)
-    far = call(ros_master, "/rascal/arm/compute_ik",
-               "{pose: {header: {frame_id: base_link}, pose: {position: {x: 1.3, y: 0, z: 0.1}, "
-               "orientation: {w: 1}}}, seed: [0, 0, 0, 0, 0, 0]}")
+    far = call(
+        ros_master,
+        "/rascal/arm/compute_ik",
+        "{pose: {header: {frame_id: base_link}, pose: {position: {x: 1.3, y: 0, z: 0.1}, "
+        "orientation: {w: 1}}}, seed: [0, 0, 0, 0, 0, 0]}",
+    )
     assert far["code"] == 1 and "out of reach" in far["message"]
-    other = call(ros_master, "/rascal/arm/compute_ik",
-                 "{pose: {header: {frame_id: camera_link}, pose: {orientation: {w: 1}}}, seed: []}")
+    other = call(
+        ros_master,
+        "/rascal/arm/compute_ik",
+        "{pose: {header: {frame_id: camera_link}, pose: {orientation: {w: 1}}}, seed: []}",
+    )
     assert other["code"] == 4 and "base_link" in other["message"]
 
 
 def run_client(master, scenario, timeout=120):
-    out = subprocess.run(["/usr/bin/python3", CLIENT, scenario], env=master.env, text=True,
-                         capture_output=True, timeout=timeout)
+    out = subprocess.run(
+        ["/usr/bin/python3", CLIENT, scenario],
+        env=master.env,
+        text=True,
+        capture_output=True,
+        timeout=timeout,
+    )
     lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
     assert out.returncode == 0 and lines, out.stdout + out.stderr
     return json.loads(lines[-1])
@@ -138,13 +178,18 @@ def test_joint_states_drive_fk_and_tf(ros_master, rosrun):
     ros_master.run(["rosparam", "load", CONFIG])
     start_controller(ros_master, rosrun)
     # A driver's joint state, published by the test (sleep pose, fingers at 20 mm).
-    state = ("{name: [waist, shoulder, elbow, forearm_roll, wrist_angle, wrist_rotate, "
-             "left_finger, right_finger], "
-             "position: [0.0, -1.80, 1.55, 0.0, 0.8, 0.0, 0.02, -0.02]}")
-    pub = subprocess.Popen(["rostopic", "pub", "-r", "20", "/joint_states",
-                            "sensor_msgs/JointState", state], env=ros_master.env,
-                           stdout=subprocess.DEVNULL,
-                           stderr=subprocess.DEVNULL, start_new_session=True)
+    state = (
+        "{name: [waist, shoulder, elbow, forearm_roll, wrist_angle, wrist_rotate, "
+        "left_finger, right_finger], "
+        "position: [0.0, -1.80, 1.55, 0.0, 0.8, 0.0, 0.02, -0.02]}"
+    )
+    pub = subprocess.Popen(
+        ["rostopic", "pub", "-r", "20", "/joint_states", "sensor_msgs/JointState", state],
+        env=ros_master.env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     try:
         deadline = time.monotonic() + 20.0
         fk = {"success": False}
@@ -158,6 +203,12 @@ def test_joint_states_drive_fk_and_tf(ros_master, rosrun):
         assert "shoulder_link" in tf and "left_finger_link" in tf
         static = ros_master.run(["rostopic", "echo", "-n", "1", "/tf_static"], timeout=30).stdout
         assert "camera_color_optical_frame" in static and "ee_gripper_link" in static
+        # The gripper state: 40 mm, and (no command since the controller started) fingers at rest
+        # between closed and open count as holding.
+        state = ros_master.run(
+            ["rostopic", "echo", "-n", "1", "/rascal/gripper/state"], timeout=30
+        ).stdout
+        assert "width: 0.04" in state and "holding: True" in state, state
     finally:
         os.killpg(pub.pid, signal.SIGINT)
         try:
@@ -225,3 +276,7 @@ class TestAgainstTheSimulator:
         assert "error" not in out, out
         assert out["held"] and not out["empty"], out
         assert out["held_width"] > 0.032 and out["empty_width"] < 0.032, out
+        # /rascal/gripper/state applies the same rule: held while lifted, not once opened or
+        # closed on nothing.
+        assert out["state_lifted"][0] and out["state_lifted"][1] > 0.032, out
+        assert not out["state_opened"][0] and not out["state_empty"][0], out

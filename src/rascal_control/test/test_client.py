@@ -1,5 +1,6 @@
 """Core tests of the Python client (no master): goal building, pose conversion, and the mapping of
 controller results to typed results and exceptions. The action clients are injected fakes."""
+
 import math
 
 import pytest
@@ -91,8 +92,9 @@ def test_go_and_move_joints_goals():
         arm.go("home", speed_scale=0.0)
 
 
-@pytest.mark.parametrize("code,error", [(1, Unreachable), (2, Collision), (3, Timeout),
-                                        (4, Preempted), (5, InvalidGoal)])
+@pytest.mark.parametrize(
+    "code,error", [(1, Unreachable), (2, Collision), (3, Timeout), (4, Preempted), (5, InvalidGoal)]
+)
 def test_failures_raise_typed_errors_with_the_reason(code, error):
     arm = Arm(move_client=FakeActionClient(move_result(code, "the reason")))
     with pytest.raises(error) as info:
@@ -109,13 +111,15 @@ def test_client_side_timeout_cancels():
 
 
 def test_gripper_close_is_truthy_when_holding():
-    held = GripperResultMsg(code=0, message="opening 41 mm", width=0.041, holding=True,
-                            duration=0.4)
+    held = GripperResultMsg(
+        code=0, message="opening 41 mm", width=0.041, holding=True, duration=0.4
+    )
     gripper = Gripper(client=FakeActionClient(held))
     result = gripper.close()
     assert result and result.holding and gripper.width == 0.041
-    empty = GripperResultMsg(code=0, message="opening 30 mm", width=0.030, holding=False,
-                             duration=0.5)
+    empty = GripperResultMsg(
+        code=0, message="opening 30 mm", width=0.030, holding=False, duration=0.5
+    )
     assert not Gripper(client=FakeActionClient(empty)).close()
 
 

@@ -2,6 +2,7 @@
 """Test helper for test_arm_controller.py: runs one scenario against a live arm_controller with the
 rascal_control Python client, in its own process (rospy can init only once per process), and
 prints one JSON line. Usage: wiring_client.py <scenario>"""
+
 import json
 import math
 import sys
@@ -44,8 +45,11 @@ def linear_path(arm):
     a, b = (0.20, 0.20, 0.12), (0.35, -0.10, 0.05)
     arm.move_to(Arm.top_down(*a, yaw=0.2))
     samples = []
-    sub = rospy.Subscriber("/joint_states", JointState,
-                           lambda m: samples.append(dict(zip(m.name, m.position, strict=False))))
+    sub = rospy.Subscriber(
+        "/joint_states",
+        JointState,
+        lambda m: samples.append(dict(zip(m.name, m.position, strict=False))),
+    )
     result = arm.move_to(Arm.top_down(*b, yaw=-0.4), motion="linear")
     sub.unregister()
     ab = [q - p for p, q in zip(a, b, strict=True)]
@@ -53,8 +57,9 @@ def linear_path(arm):
     for s in samples[::2]:
         p = arm.compute_fk([s[n] for n in ARM]).pose.position
         ap = (p.x - a[0], p.y - a[1], p.z - a[2])
-        u = max(0.0, min(1.0, sum(x * y for x, y in zip(ap, ab, strict=True))
-                         / sum(x * x for x in ab)))
+        u = max(
+            0.0, min(1.0, sum(x * y for x, y in zip(ap, ab, strict=True)) / sum(x * x for x in ab))
+        )
         worst = max(worst, math.dist((p.x, p.y, p.z), [a[i] + u * ab[i] for i in range(3)]))
     return {"samples": len(samples), "deviation": worst, "duration": result.duration}
 
@@ -99,8 +104,13 @@ def cancel(arm):
     arm.go("home")
     client = arm._move  # the goal is sent asynchronously so it can be cancelled mid-way
     from rascal_msgs.msg import MoveArmGoal
-    goal = MoveArmGoal(target_type=MoveArmGoal.TARGET_JOINTS, joints=[2.5, 0.3, 0.3, 0, 1.0, 0],
-                       motion=MoveArmGoal.MOTION_JOINT, speed_scale=0.3)
+
+    goal = MoveArmGoal(
+        target_type=MoveArmGoal.TARGET_JOINTS,
+        joints=[2.5, 0.3, 0.3, 0, 1.0, 0],
+        motion=MoveArmGoal.MOTION_JOINT,
+        speed_scale=0.3,
+    )
     client.send_goal(goal)
     rospy.sleep(0.6)
     client.cancel_goal()
@@ -110,12 +120,28 @@ def cancel(arm):
     a = joints()
     rospy.sleep(0.5)
     b = joints()
-    return {"code": result.code, "message": result.message, "waist": a[0],
-            "drift": max(abs(x - y) for x, y in zip(a, b, strict=True))}
+    return {
+        "code": result.code,
+        "message": result.message,
+        "waist": a[0],
+        "drift": max(abs(x - y) for x, y in zip(a, b, strict=True)),
+    }
+
+
+def gripper_state():
+    """The controller's gripper state, the first one stamped after this call."""
+    from rascal_msgs.msg import GripperState
+
+    now = rospy.Time.now()
+    while True:
+        msg = rospy.wait_for_message("/rascal/gripper/state", GripperState, timeout=10.0)
+        if msg.header.stamp >= now:
+            return msg
 
 
 def grasp(arm, gripper):
     from rascal_msgs.srv import GetGroundTruth
+
     rospy.wait_for_service("/sim/ground_truth", 10.0)
     sherds = rospy.ServiceProxy("/sim/ground_truth", GetGroundTruth)().sherds
     # The sherd nearest the middle of the pickup area; fingers across its minor axis.
@@ -129,13 +155,25 @@ def grasp(arm, gripper):
     arm.move_to(Arm.top_down(x, y, max(0.013, top - 0.003), yaw), motion="linear", speed_scale=0.5)
     held = gripper.close()
     arm.move_to(Arm.top_down(x, y, top + 0.06, yaw), motion="linear")
+    lifted = gripper_state()
     empty_open = gripper.open()
+    opened = gripper_state()
     arm.move_to(Arm.top_down(0.30, 0.10, 0.15))  # over the bare table
     empty = gripper.close()
-    return {"held": held.holding, "held_width": held.width, "held_seconds": held.duration,
-            "empty": empty.holding,
-            "empty_width": empty.width, "open_width": empty_open.width,
-            "sherd_width": s.width, "sherd": s.name}
+    closed = gripper_state()
+    return {
+        "held": held.holding,
+        "state_lifted": [lifted.holding, lifted.width],
+        "state_opened": [opened.holding, opened.width],
+        "state_empty": [closed.holding, closed.width],
+        "held_width": held.width,
+        "held_seconds": held.duration,
+        "empty": empty.holding,
+        "empty_width": empty.width,
+        "open_width": empty_open.width,
+        "sherd_width": s.width,
+        "sherd": s.name,
+    }
 
 
 def main():
@@ -146,9 +184,14 @@ def main():
         if scenario == "grasp":
             out = grasp(arm, gripper)
         else:
-            run = {"pose_goal": pose_goal, "unreachable": unreachable, "cancel": cancel,
-                   "collision": collision, "no_driver": no_driver,
-                   "linear_path": linear_path}[scenario]
+            run = {
+                "pose_goal": pose_goal,
+                "unreachable": unreachable,
+                "cancel": cancel,
+                "collision": collision,
+                "no_driver": no_driver,
+                "linear_path": linear_path,
+            }[scenario]
             out = run(arm)
     except ControlError as e:
         out = error_dict(e)

@@ -1,4 +1,5 @@
 """Core tests of the ROS adapters' conversions (no master needed)."""
+
 import math
 
 import pytest
@@ -15,8 +16,12 @@ from rascal_tasks.ros_rig import observation_from_msg  # noqa: E402
 def test_grasp_yaw_survives_the_pitched_orientation(yaw):
     """The gripper points down (pitch pi/2), where Euler yaw extraction is degenerate."""
     s = Sherd()
-    (s.grasp_pose.orientation.x, s.grasp_pose.orientation.y, s.grasp_pose.orientation.z,
-     s.grasp_pose.orientation.w) = quaternion_from_rpy(0.0, math.pi / 2, yaw)
+    (
+        s.grasp_pose.orientation.x,
+        s.grasp_pose.orientation.y,
+        s.grasp_pose.orientation.z,
+        s.grasp_pose.orientation.w,
+    ) = quaternion_from_rpy(0.0, math.pi / 2, yaw)
     s.pose.orientation.w = 1.0
     o = observation_from_msg(s)
     assert o.grasp_yaw == pytest.approx(yaw, abs=1e-9)

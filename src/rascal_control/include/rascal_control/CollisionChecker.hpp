@@ -15,6 +15,7 @@
 
 #include "rascal_control/JointPath.hpp"
 #include "rascal_control/KinematicModel.hpp"
+#include "rascal_workcell/Workcell.hpp"
 
 namespace rascal_control {
 
@@ -38,15 +39,16 @@ class CollisionChecker {
     JointVector q{};
   };
 
-  // `finger` [m]: finger position assumed for the fingers' bodies (0.037 = fully open, widest).
+  // `finger` [m]: finger position assumed for the fingers' bodies (default: the URDF's upper limit
+  // of left_finger, fully open, widest).
   // The arm's own base (base_link's collision boxes) is a fixture from the start: every link but
   // shoulder_link and upper_arm_link must keep off it.
-  explicit CollisionChecker(const KinematicModel& model, double finger = 0.037);
+  explicit CollisionChecker(const KinematicModel& model, std::optional<double> finger = std::nullopt);
 
   void addFixture(const Fixture& fixture);
-  // An open box (the discard box): four walls of `wall_thickness` around a rectangle.
-  void addOpenBox(const std::string& name, double x, double y, double size_x, double size_y,
-                  double wall_height, double wall_thickness);
+  // The workcell's fixtures (rascal_workcell::Workcell::collisionBoxes()); a support box (the
+  // scale platform) may be touched by the fingertips.
+  void addFixtures(const std::vector<rascal_workcell::FixtureBox>& boxes);
   // The table top z = 0 (on by default).
   void setTable(bool enabled) { table_ = enabled; }
   const std::vector<Fixture>& fixtures() const { return fixtures_; }

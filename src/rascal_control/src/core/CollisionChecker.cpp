@@ -31,7 +31,14 @@ bool isFinger(const std::string& link) {
 
 }  // namespace
 
-CollisionChecker::CollisionChecker(const KinematicModel& model, double finger) : model_(model) {
+CollisionChecker::CollisionChecker(const KinematicModel& model, std::optional<double> finger_position)
+    : model_(model) {
+  double lower = 0.0, finger = 0.0;
+  if (finger_position) {
+    finger = *finger_position;
+  } else if (!model_.jointLimits("left_finger", lower, finger)) {
+    throw std::runtime_error("CollisionChecker: the URDF has no left_finger joint with limits");
+  }
   const KDL::Tree& tree = model_.tree();
   std::vector<Fixture> base;
   for (const CollisionShape& shape : model_.collisionShapes()) {
@@ -112,17 +119,11 @@ void CollisionChecker::addFixture(const Fixture& fixture) {
   fixture_objects_.push_back(object);
 }
 
-void CollisionChecker::addOpenBox(const std::string& name, double x, double y, double size_x,
-                                  double size_y, double wall_height, double wall_thickness) {
-  const double h = wall_height, t = wall_thickness;
-  addFixture({name + " wall -x", KDL::Vector(x - size_x / 2.0 + t / 2.0, y, h / 2.0),
-              KDL::Vector(t, size_y, h), false, {}});
-  addFixture({name + " wall +x", KDL::Vector(x + size_x / 2.0 - t / 2.0, y, h / 2.0),
-              KDL::Vector(t, size_y, h), false, {}});
-  addFixture({name + " wall -y", KDL::Vector(x, y - size_y / 2.0 + t / 2.0, h / 2.0),
-              KDL::Vector(size_x, t, h), false, {}});
-  addFixture({name + " wall +y", KDL::Vector(x, y + size_y / 2.0 - t / 2.0, h / 2.0),
-              KDL::Vector(size_x, t, h), false, {}});
+void CollisionChecker::addFixtures(const std::vector<rascal_workcell::FixtureBox>& boxes) {
+  for (const rascal_workcell::FixtureBox& b : boxes) {
+    addFixture({b.name, KDL::Vector(b.centre.x(), b.centre.y(), b.centre.z()),
+                KDL::Vector(b.size.x(), b.size.y(), b.size.z()), b.is_support, {}});
+  }
 }
 
 void CollisionChecker::contacts(const JointVector& q, std::vector<Pair>& out,

@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include <ros/ros.h>
+#include <tf2_kdl/tf2_kdl.h>
+
 namespace rascal_control {
 
 bool poseToFrame(const geometry_msgs::Pose& pose, KDL::Frame& frame, std::string& why) {
@@ -16,31 +19,22 @@ bool poseToFrame(const geometry_msgs::Pose& pose, KDL::Frame& frame, std::string
     why = "orientation quaternion has length " + std::to_string(norm) + ", expected 1";
     return false;
   }
-  frame = KDL::Frame(KDL::Rotation::Quaternion(o.x / norm, o.y / norm, o.z / norm, o.w / norm),
-                     KDL::Vector(p.x, p.y, p.z));
+  geometry_msgs::Pose unit = pose;
+  unit.orientation.x /= norm;
+  unit.orientation.y /= norm;
+  unit.orientation.z /= norm;
+  unit.orientation.w /= norm;
+  tf2::fromMsg(unit, frame);
   return true;
 }
 
-geometry_msgs::Pose frameToPose(const KDL::Frame& frame) {
-  geometry_msgs::Pose pose;
-  pose.position.x = frame.p.x();
-  pose.position.y = frame.p.y();
-  pose.position.z = frame.p.z();
-  frame.M.GetQuaternion(pose.orientation.x, pose.orientation.y, pose.orientation.z,
-                        pose.orientation.w);
-  return pose;
-}
+geometry_msgs::Pose frameToPose(const KDL::Frame& frame) { return tf2::toMsg(frame); }
 
 geometry_msgs::TransformStamped toTransform(const LinkTransform& transform, const ros::Time& stamp) {
-  geometry_msgs::TransformStamped out;
+  geometry_msgs::TransformStamped out = tf2::kdlToTransform(transform.pose);
   out.header.stamp = stamp;
   out.header.frame_id = transform.parent;
   out.child_frame_id = transform.child;
-  out.transform.translation.x = transform.pose.p.x();
-  out.transform.translation.y = transform.pose.p.y();
-  out.transform.translation.z = transform.pose.p.z();
-  transform.pose.M.GetQuaternion(out.transform.rotation.x, out.transform.rotation.y,
-                                 out.transform.rotation.z, out.transform.rotation.w);
   return out;
 }
 
@@ -64,6 +58,17 @@ trajectory_msgs::JointTrajectory stopTrajectory(const ros::Time& stamp) {
   trajectory_msgs::JointTrajectory msg;
   msg.header.stamp = stamp;
   msg.joint_names.assign(KinematicModel::armJointNames().begin(), KinematicModel::armJointNames().end());
+  return msg;
+}
+
+trajectory_msgs::JointTrajectory fingerCommand(double finger, double seconds, const ros::Time& stamp) {
+  trajectory_msgs::JointTrajectory msg;
+  msg.header.stamp = stamp;
+  msg.joint_names = {"left_finger"};
+  trajectory_msgs::JointTrajectoryPoint point;
+  point.positions = {finger};
+  point.time_from_start = ros::Duration(seconds);
+  msg.points.push_back(point);
   return msg;
 }
 
@@ -99,5 +104,13 @@ JointVector toJointVector(const std::vector<double>& values) {
 }
 
 std::vector<double> toStdVector(const JointVector& q) { return std::vector<double>(q.begin(), q.end()); }
+
+bool driverListening(const ros::Publisher& publisher, double wait) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait);
+  while (publisher.getNumSubscribers() == 0 && ros::ok() && ros::WallTime::now() < deadline) {
+    ros::WallDuration(0.005).sleep();
+  }
+  return publisher.getNumSubscribers() > 0;
+}
 
 }  // namespace rascal_control

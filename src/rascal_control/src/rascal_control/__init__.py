@@ -12,6 +12,7 @@
 
 Failures raise a subclass of ControlError carrying the controller's code and one-line reason.
 """
+
 from rascal_control.arm import Arm
 from rascal_control.gripper import Gripper
 from rascal_control.results import (
@@ -26,6 +27,14 @@ from rascal_control.results import (
 )
 
 __all__ = [
-    "Arm", "Gripper", "MoveResult", "GripperResult", "ControlError", "Unreachable", "Collision",
-    "Timeout", "Preempted", "InvalidGoal",
+    "Arm",
+    "Gripper",
+    "MoveResult",
+    "GripperResult",
+    "ControlError",
+    "Unreachable",
+    "Collision",
+    "Timeout",
+    "Preempted",
+    "InvalidGoal",
 ]

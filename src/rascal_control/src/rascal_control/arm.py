@@ -1,4 +1,5 @@
 """rascal_control.Arm: move the arm by pose, named pose or joints through /rascal/arm/move."""
+
 import math
 from typing import Optional, Sequence
 
@@ -13,14 +14,19 @@ def quaternion_from_rpy(roll: float, pitch: float, yaw: float):
     cr, sr = math.cos(roll / 2), math.sin(roll / 2)
     cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
     cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
 
 
 def to_pose_stamped(pose):
     """PoseStamped in base_link from a PoseStamped, a Pose, (x, y, z, roll, pitch, yaw) or
     (x, y, z, qx, qy, qz, qw)."""
     from geometry_msgs.msg import Pose, PoseStamped
+
     if isinstance(pose, PoseStamped):
         if not pose.header.frame_id:
             pose.header.frame_id = "base_link"
@@ -36,11 +42,17 @@ def to_pose_stamped(pose):
     elif len(values) == 7:
         quat = values[3:]
     else:
-        raise ValueError("a pose is a PoseStamped, a Pose, (x, y, z, roll, pitch, yaw) or "
-                         "(x, y, z, qx, qy, qz, qw); got %d numbers" % len(values))
+        raise ValueError(
+            "a pose is a PoseStamped, a Pose, (x, y, z, roll, pitch, yaw) or "
+            "(x, y, z, qx, qy, qz, qw); got %d numbers" % len(values)
+        )
     out.pose.position.x, out.pose.position.y, out.pose.position.z = values[:3]
-    (out.pose.orientation.x, out.pose.orientation.y, out.pose.orientation.z,
-     out.pose.orientation.w) = quat
+    (
+        out.pose.orientation.x,
+        out.pose.orientation.y,
+        out.pose.orientation.z,
+        out.pose.orientation.w,
+    ) = quat
     return out
 
 
@@ -58,10 +70,14 @@ class Arm:
             from rascal_msgs.srv import ComputeFK, ComputeIK
 
             from rascal_control.goal_runner import GoalRunner
+
             move_client = GoalRunner("/rascal/arm/move", MoveArmAction)
             if not move_client.wait_for_server(rospy.Duration(wait)):
-                raise Timeout(3, "no /rascal/arm/move action server within %.0f s; is "
-                                 "arm_controller running?" % wait)
+                raise Timeout(
+                    3,
+                    "no /rascal/arm/move action server within %.0f s; is "
+                    "arm_controller running?" % wait,
+                )
             try:
                 rospy.wait_for_service("/rascal/arm/compute_ik", wait)
             except rospy.ROSException as e:
@@ -79,24 +95,35 @@ class Arm:
         """ee_gripper_link pointing straight down at (x, y, z), turned by `yaw` about z."""
         return to_pose_stamped((x, y, z, 0.0, math.pi / 2, yaw))
 
-    def move_to(self, pose, motion: str = "joint", speed_scale: float = 1.0,
-                timeout: Optional[float] = None) -> MoveResult:
+    def move_to(
+        self, pose, motion: str = "joint", speed_scale: float = 1.0, timeout: Optional[float] = None
+    ) -> MoveResult:
         """Move ee_gripper_link to `pose` (see to_pose_stamped) by a joint or linear motion."""
         goal = self._goal(motion, speed_scale)
         goal.target_type = goal.TARGET_POSE
         goal.pose = to_pose_stamped(pose)
         return self._run(goal, timeout)
 
-    def go(self, name: str, motion: str = "joint", speed_scale: float = 1.0,
-           timeout: Optional[float] = None) -> MoveResult:
+    def go(
+        self,
+        name: str,
+        motion: str = "joint",
+        speed_scale: float = 1.0,
+        timeout: Optional[float] = None,
+    ) -> MoveResult:
         """Move to a named pose of the config (arm/named_poses), e.g. "home", "sleep"."""
         goal = self._goal(motion, speed_scale)
         goal.target_type = goal.TARGET_NAMED
         goal.named_pose = name
         return self._run(goal, timeout)
 
-    def move_joints(self, joints: Sequence[float], motion: str = "joint", speed_scale: float = 1.0,
-                    timeout: Optional[float] = None) -> MoveResult:
+    def move_joints(
+        self,
+        joints: Sequence[float],
+        motion: str = "joint",
+        speed_scale: float = 1.0,
+        timeout: Optional[float] = None,
+    ) -> MoveResult:
         """Move to a joint vector [rad]: waist, shoulder, elbow, forearm_roll, wrist_angle,
         wrist_rotate."""
         goal = self._goal(motion, speed_scale)
@@ -132,6 +159,7 @@ class Arm:
     @staticmethod
     def _goal(motion: str, speed_scale: float):
         from rascal_msgs.msg import MoveArmGoal
+
         if motion not in MOTIONS:
             raise ValueError("motion must be 'joint' or 'linear', not %r" % (motion,))
         if not 0.0 < speed_scale <= 1.0:
@@ -143,12 +171,14 @@ class Arm:
 
     def _run(self, goal, timeout: Optional[float]) -> MoveResult:
         import rospy
+
         self._move.send_goal(goal)
         finished = self._move.wait_for_result(rospy.Duration(timeout or 0.0))
         if not finished:
             self._move.cancel_goal()
-            raise Timeout(3, "no result from /rascal/arm/move within %.1f s; move cancelled"
-                          % timeout)
+            raise Timeout(
+                3, "no result from /rascal/arm/move within %.1f s; move cancelled" % timeout
+            )
         msg = self._move.get_result()
         if msg is None:
             raise Timeout(3, "/rascal/arm/move ended without a result (controller gone?)")

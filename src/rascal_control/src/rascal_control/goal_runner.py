@@ -7,6 +7,7 @@ tracking" (ros/actionlib#206), and wait_for_result() may then never return. Goal
 plain ActionClient and a per-goal event set from the transition callback itself, so no
 transition can be lost. It offers the SimpleActionClient methods the clients use.
 """
+
 import threading
 import time
 
@@ -14,6 +15,7 @@ import time
 class GoalRunner:
     def __init__(self, name: str, action_type):
         import actionlib
+
         self._actionlib = actionlib
         self._client = actionlib.ActionClient(name, action_type)
         self._gh = None
@@ -24,6 +26,7 @@ class GoalRunner:
         own timeout in ROS time, which under use_sim_time starts at 0 and then jumps to the
         simulator's clock (or races ahead of the wall clock), so it can give up at once."""
         import rospy
+
         seconds = timeout.to_sec() if hasattr(timeout, "to_sec") else float(timeout)
         deadline = time.monotonic() + seconds
         while not rospy.is_shutdown():
@@ -48,6 +51,7 @@ class GoalRunner:
     def wait_for_result(self, timeout) -> bool:
         """True when the goal finished; `timeout` (rospy.Duration) 0 = no limit."""
         import rospy
+
         seconds = timeout.to_sec()
         start = None  # ROS time is 0 until a simulator's first /clock arrives
         while not rospy.is_shutdown():

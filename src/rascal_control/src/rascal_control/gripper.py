@@ -1,10 +1,9 @@
 """rascal_control.Gripper: open, close or set the gripper through /rascal/gripper."""
+
 from typing import Optional
 
+from rascal_control.gripper_limits import opening_limits
 from rascal_control.results import OK, GripperResult, Timeout, move_error
-
-MIN_WIDTH = 0.030  # [m] opening between the fingertips, closed (URDF finger limits)
-MAX_WIDTH = 0.074  # [m] fully open
 
 
 class Gripper:
@@ -17,12 +16,18 @@ class Gripper:
             from rascal_msgs.msg import GripperAction
 
             from rascal_control.goal_runner import GoalRunner
+
             client = GoalRunner("/rascal/gripper", GripperAction)
             if not client.wait_for_server(rospy.Duration(wait)):
-                raise Timeout(3, "no /rascal/gripper action server within %.0f s; is "
-                                 "arm_controller running?" % wait)
+                raise Timeout(
+                    3,
+                    "no /rascal/gripper action server within %.0f s; is "
+                    "arm_controller running?" % wait,
+                )
         self._client = client
         self.last_result: Optional[GripperResult] = None
+        # [m] opening between the fingertips, closed and fully open (the URDF's finger limits)
+        self.min_width, self.max_width = opening_limits()
 
     @property
     def width(self) -> Optional[float]:
@@ -38,14 +43,17 @@ class Gripper:
         return self._run(1, 0.0, timeout)
 
     def set_width(self, width: float, timeout: Optional[float] = None) -> GripperResult:
-        """Move the fingers to an opening of `width` [m], 0.030..0.074."""
-        if not MIN_WIDTH <= width <= MAX_WIDTH:
-            raise ValueError("width %.4f m is outside [%.3f, %.3f]" % (width, MIN_WIDTH, MAX_WIDTH))
+        """Move the fingers to an opening of `width` [m], min_width..max_width (0.030..0.074)."""
+        if not self.min_width <= width <= self.max_width:
+            raise ValueError(
+                "width %.4f m is outside [%.3f, %.3f]" % (width, self.min_width, self.max_width)
+            )
         return self._run(2, width, timeout)
 
     def _run(self, command: int, width: float, timeout: Optional[float]) -> GripperResult:
         import rospy
         from rascal_msgs.msg import GripperGoal
+
         goal = GripperGoal(command=command, width=float(width))
         self._client.send_goal(goal)
         if not self._client.wait_for_result(rospy.Duration(timeout or 0.0)):

@@ -1,4 +1,5 @@
 """Typed results and exceptions of the arm and gripper clients (no ROS needed)."""
+
 from dataclasses import dataclass, field
 from typing import List
 
@@ -44,10 +45,19 @@ class InvalidGoal(ControlError):
     """The request itself is malformed (frame, quaternion, unknown named pose, width range)."""
 
 
-_MOVE_ERRORS = {UNREACHABLE: Unreachable, COLLISION: Collision, TIMEOUT: Timeout,
-                PREEMPTED: Preempted, INVALID_GOAL: InvalidGoal}
-_IK_ERRORS = {UNREACHABLE: Unreachable, IK_JOINT_LIMIT: Unreachable, IK_SINGULAR: Unreachable,
-              IK_INVALID: InvalidGoal}
+_MOVE_ERRORS = {
+    UNREACHABLE: Unreachable,
+    COLLISION: Collision,
+    TIMEOUT: Timeout,
+    PREEMPTED: Preempted,
+    INVALID_GOAL: InvalidGoal,
+}
+_IK_ERRORS = {
+    UNREACHABLE: Unreachable,
+    IK_JOINT_LIMIT: Unreachable,
+    IK_SINGULAR: Unreachable,
+    IK_INVALID: InvalidGoal,
+}
 
 
 def move_error(code: int, message: str, result=None) -> ControlError:
@@ -63,9 +73,10 @@ def ik_error(code: int, message: str) -> ControlError:
 @dataclass
 class MoveResult:
     """A finished arm move."""
+
     code: int
     message: str
-    duration: float                      # [s] executed (sim time under use_sim_time)
+    duration: float  # [s] executed (sim time under use_sim_time)
     joints: List[float] = field(default_factory=list)  # [rad] at the end
 
     @property
@@ -76,11 +87,12 @@ class MoveResult:
 @dataclass
 class GripperResult:
     """A finished gripper command; truthy when an object is held."""
+
     code: int
     message: str
-    width: float                         # [m] opening between the fingertips at the end
-    holding: bool                        # fingers stopped short of closed
-    duration: float                      # [s]
+    width: float  # [m] opening between the fingertips at the end
+    holding: bool  # fingers stopped short of closed
+    duration: float  # [s]
 
     def __bool__(self) -> bool:
         return self.holding

@@ -4,25 +4,27 @@ Arm and gripper go through rascal_control's Python client (the `/rascal/arm/move
 `/rascal/gripper` actions); perception, scale and archival camera through their services and
 topics. Every wait is sliced and gives up with a RigError naming the topic or service.
 """
+
 import math
 import threading
+import time
 
 import rospy
 from rascal_control import Arm as ControlArm
 from rascal_control import Gripper as ControlGripper
 from rascal_control.results import ControlError, Timeout
-from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
+from rascal_msgs.msg import GripperState
 from rascal_msgs.msg import ScaleReading as ScaleReadingMsg
 from rascal_msgs.srv import CalibrateBackground, CaptureArchival, Detect
 from rascal_tasks import rig
 
 SERVICE_WAIT = 30.0  # s (wall clock): how long a node may take to come up
-# Fingers closed on nothing stop at 30 mm (facts §1.4); a sherd keeps them wider by at least the
-# arm controller's arm.gripper.held_margin, the same rule its close result uses.
-CLOSED_OPENING = 0.030
-FULLY_OPEN = 0.074 - 0.004
+# The arm controller publishes the gripper's opening and whether it holds something (its one
+# holding rule, the same its close result uses) with every /joint_states message.
+GRIPPER_STATE = "/rascal/gripper/state"
+GRIPPER_STATE_WAIT = 2.0  # s (wall clock) without a fresh gripper state: the controller is silent
 CODE_NAMES = {1: "UNREACHABLE", 2: "COLLISION", 3: "TIMEOUT", 4: "PREEMPTED", 5: "INVALID_GOAL"}
 
 
@@ -39,19 +41,29 @@ def _gripper_yaw(q) -> float:
 def observation_from_msg(s) -> rig.Observation:
     """rascal_msgs/Sherd -> Observation (both in base_link)."""
     return rig.Observation(
-        x=s.pose.position.x, y=s.pose.position.y, yaw=_yaw(s.pose.orientation),
-        length=s.length, width=s.width, height=s.height,
-        grasp_x=s.grasp_pose.position.x, grasp_y=s.grasp_pose.position.y,
-        grasp_z=s.grasp_pose.position.z, grasp_yaw=_gripper_yaw(s.grasp_pose.orientation),
-        grasp_width=s.grasp_width, colour=(s.color.r, s.color.g, s.color.b), score=s.score)
+        x=s.pose.position.x,
+        y=s.pose.position.y,
+        yaw=_yaw(s.pose.orientation),
+        length=s.length,
+        width=s.width,
+        height=s.height,
+        grasp_x=s.grasp_pose.position.x,
+        grasp_y=s.grasp_pose.position.y,
+        grasp_z=s.grasp_pose.position.z,
+        grasp_yaw=_gripper_yaw(s.grasp_pose.orientation),
+        grasp_width=s.grasp_width,
+        colour=(s.color.r, s.color.g, s.color.b),
+        score=s.score,
+    )
 
 
 def _proxy(name, srv_type):
     try:
         rospy.wait_for_service(name, timeout=SERVICE_WAIT)
     except rospy.ROSException:
-        raise rig.RigError(name, "MISSING", "service %s is not offered; is its node running?"
-                           % name) from None
+        raise rig.RigError(
+            name, "MISSING", "service %s is not offered; is its node running?" % name
+        ) from None
     return rospy.ServiceProxy(name, srv_type)
 
 
@@ -73,8 +85,9 @@ class RosArm(rig.Arm):
         pose = ControlArm.top_down(x, y, z, yaw)
         for attempt in range(2):
             try:
-                return self._arm.move_to(pose, motion="linear" if linear else "joint",
-                                         speed_scale=self.speed_scale).duration
+                return self._arm.move_to(
+                    pose, motion="linear" if linear else "joint", speed_scale=self.speed_scale
+                ).duration
             except Timeout as e:
                 # The arm did not arrive (a stalled or lost trajectory): send the goal once more
                 # from where it is; a second timeout is a fault for a person to look at.
@@ -95,51 +108,59 @@ class RosArm(rig.Arm):
 
 
 class RosGripper(rig.Gripper):
-    """rascal_control.Gripper, plus the finger gap from /joint_states to notice a drop."""
+    """rascal_control.Gripper, plus the controller's gripper state (GRIPPER_STATE) to notice a
+    drop: whether a sherd is held is the controller's decision, not a threshold applied here."""
 
-    def __init__(self, held_margin: float = 0.002):
-        self._empty_opening = CLOSED_OPENING + held_margin  # at or below: nothing in the fingers
+    def __init__(self, held_margin=None):
+        del held_margin  # unused: the controller applies arm.gripper.held_margin (kept for callers)
         try:
             self._gripper = ControlGripper(wait=SERVICE_WAIT)
         except ControlError as e:
             raise _rig_error("/rascal/gripper", e) from None
-        self._opening = None
-        self._closed = None  # the last command was a close (None: none sent yet, after a restart)
-        self._sub = rospy.Subscriber("/joint_states", JointState, self._on_joints, queue_size=2)
+        self._state = None  # the latest rascal_msgs/GripperState
+        self._after = rospy.Time(0)  # a state stamped before the last command ended is stale
+        self._sub = rospy.Subscriber(GRIPPER_STATE, GripperState, self._on_state, queue_size=2)
 
-    def _on_joints(self, msg):
-        if "left_finger" in msg.name:
-            self._opening = 2.0 * msg.position[msg.name.index("left_finger")]
+    def _on_state(self, msg):
+        self._state = msg
 
     def _run(self, fn, *args):
         try:
             return fn(*args)
         except ControlError as e:
             raise _rig_error("gripper", e) from None
+        finally:
+            self._after = rospy.Time.now()
+
+    def _fresh_state(self):
+        """The first gripper state stamped after the last command ended; RigError when none comes
+        within GRIPPER_STATE_WAIT seconds of wall time."""
+        deadline = time.monotonic() + GRIPPER_STATE_WAIT
+        while not rospy.is_shutdown():
+            state = self._state
+            if state is not None and state.header.stamp >= self._after:
+                return state
+            if time.monotonic() > deadline:
+                break
+            time.sleep(0.005)
+        raise rig.RigError(
+            GRIPPER_STATE,
+            "TIMEOUT",
+            "no gripper state for %.0f s; is arm_controller running?" % GRIPPER_STATE_WAIT,
+        )
 
     def open(self, width=None):
-        self._closed = False
         return self._run(self._gripper.open, width).duration
 
     def close(self):
-        self._closed = True
         res = self._run(self._gripper.close)
         return rig.GraspResult(bool(res.holding), res.width)
 
     def holding(self):
-        if self._closed is False:
-            return False
-        deadline = rospy.get_time() + 1.0
-        while self._opening is None and rospy.get_time() < deadline:
-            rospy.sleep(0.01)
-        if self._opening is None:
-            return False
-        if self._closed is None:  # after a restart: fingers neither open nor shut on nothing
-            return self._empty_opening < self._opening < FULLY_OPEN
-        return self._opening > self._empty_opening
+        return bool(self._fresh_state().holding)
 
     def width(self):
-        return self._opening if self._opening is not None else 0.0
+        return self._fresh_state().width
 
 
 class RosPerception(rig.Perception):
@@ -161,8 +182,13 @@ class RosPerception(rig.Perception):
                 raise rig.RigError("perception", what, str(e)) from None
             if res.success:
                 return res
-            rospy.logwarn("perception %s at %s failed (attempt %d): %s", what.lower(), station,
-                          attempt + 1, res.message)
+            rospy.logwarn(
+                "perception %s at %s failed (attempt %d): %s",
+                what.lower(),
+                station,
+                attempt + 1,
+                res.message,
+            )
             rospy.sleep(self.RETRY_WAIT)
         raise rig.RigError("perception", what, res.message)
 

@@ -127,7 +127,7 @@ def make_rig(cfg) -> Rig:
     clock = RosClock()
     return Rig(
         arm=RosArm(),
-        gripper=RosGripper(cfg["arm"]["gripper"]["held_margin"]),
+        gripper=RosGripper(),
         perception=RosPerception(),
         scale=RosScale(clock),
         camera=RosArchivalCamera(),
