@@ -200,15 +200,23 @@ class RosPerception(rig.Perception):
         return [observation_from_msg(s) for s in res.detections.sherds]
 
     def detect_if_calibrated(self, station):
-        try:
-            res = self._detect(station)
-        except rospy.ServiceException as e:
-            raise rig.RigError("perception", "DETECT", str(e)) from None
-        if res.success:
-            return [observation_from_msg(s) for s in res.detections.sherds]
-        if "no background model" in res.message:
-            return None
-        return self.detect(station)  # any other failure: the usual retries
+        """Detections, or None when the station has no background model yet. Any attempt may be
+        the one that says so: one that failed first on a frame or transform still on its way (at
+        start-up with the simulator at full speed) says it on the retry."""
+        for attempt in range(self.ATTEMPTS):
+            try:
+                res = self._detect(station)
+            except rospy.ServiceException as e:
+                raise rig.RigError("perception", "DETECT", str(e)) from None
+            if res.success:
+                return [observation_from_msg(s) for s in res.detections.sherds]
+            if "no background model" in res.message:
+                return None
+            rospy.logwarn(
+                "perception detect at %s failed (attempt %d): %s", station, attempt + 1, res.message
+            )
+            rospy.sleep(self.RETRY_WAIT)
+        raise rig.RigError("perception", "DETECT", res.message)
 
 
 class RosScale(rig.Scale):
