@@ -3,6 +3,7 @@ master, the catalogue, and the simulator's test-only services."""
 
 import os
 import subprocess
+import time
 
 import psycopg2
 import psycopg2.extras
@@ -14,11 +15,69 @@ WORKSPACE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIOS = os.path.join(WORKSPACE, "config", "scenarios")
 
 
-def start_rig(ros_master, scenario, archive, params=None):
+def start_rig(ros_master, scenario, archive, params=None, **kw):
+    """The simulated rig on the test's master; `kw` goes to SimRig (nodes=, ready=)."""
     params = dict({"/archive/root": str(archive)}, **(params or {}))
     return SimRig(
-        scenario=scenario, params=params, master_env=ros_master.env, log_dir=ros_master.log_dir
+        scenario=scenario,
+        params=params,
+        master_env=ros_master.env,
+        log_dir=ros_master.log_dir,
+        **kw,
     )
+
+
+def rascal(rig, *args, env=None):
+    """Start `rosrun rascal_tasks rascal ARGS...` against `rig` with extra environment `env`
+    (stdout and stderr together, text); the rig stops it at teardown."""
+    proc = subprocess.Popen(
+        ["rosrun", "rascal_tasks", "rascal", *args],
+        env=dict(rig.env, **(env or {})),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+        cwd=rig.ws,
+    )
+    rig.procs.append(proc)
+    return proc
+
+
+def wait_until(predicate, timeout, what, poll=0.2):
+    """Poll `predicate()` until it is true; AssertionError naming `what` after `timeout` s."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return
+        time.sleep(poll)
+    raise AssertionError("%s: not within %.0f s" % (what, timeout))
+
+
+def database_name(dsn):
+    return dsn.rsplit("/", 1)[1]
+
+
+def block_database(admin_dsn, dsn, allow):
+    """`allow=False`: refuse new connections to the database of `dsn` and end the ones it has
+    (what a restart of PostgreSQL does to a client, without stopping the server other tests
+    share); `allow=True`: accept connections again. Run from a connection to `admin_dsn`."""
+    name = database_name(dsn)
+    admin = psycopg2.connect(admin_dsn)
+    admin.autocommit = True
+    try:
+        with admin.cursor() as cur:
+            # a generated test database's name, never user input
+            cur.execute(
+                "ALTER DATABASE %s ALLOW_CONNECTIONS %s" % (name, "true" if allow else "false")
+            )
+            if not allow:
+                cur.execute(
+                    "SELECT pg_terminate_backend(pid) FROM pg_stat_activity "
+                    "WHERE datname = %s AND pid <> pg_backend_pid()",
+                    (name,),
+                )
+    finally:
+        admin.close()
 
 
 def migrate(dsn):

@@ -10,6 +10,8 @@ import time
 import pytest
 from rig_helpers import SCENARIOS, ground_truth, inject, joint_positions, migrate, rows, start_rig
 
+from rascal_tasks import exit_codes
+
 pytestmark = pytest.mark.timeout(900)
 
 SMALL = os.path.join(SCENARIOS, "small_3.yaml")
@@ -49,7 +51,7 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
     code, out = run_batch(rig, db, "E2E-3")
-    assert code == 0, out[-3000:] + rig.tail()
+    assert code == exit_codes.COMPLETE, out[-3000:] + rig.tail()
     recorded = rows(db, "E2E-3")
     assert [r["seq"] for r in recorded] == [1, 2, 3], out[-2000:]
     assert all(r["status"] == "done" for r in recorded), recorded
@@ -93,7 +95,7 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
         capture_output=True,
         text=True,
     )
-    assert report.returncode == 0, report.stderr
+    assert report.returncode == exit_codes.COMPLETE, report.stderr
     page = (tmp_path / "archive" / "E2E-3" / "report" / "index.html").read_text()
     assert page.count("<img ") == 3 and "<svg" in page
 
@@ -105,8 +107,9 @@ def test_database_down_gives_clear_error_and_arm_does_not_move(rig_factory, tmp_
         "--dsn", "postgresql://rascal:rascal@127.0.0.1:1/rascal", "run", "--context", "E2E-DOWN"
     )
     out, _ = proc.communicate(timeout=120)
-    assert proc.returncode == 3
-    assert "database" in out and "cannot connect" in out
+    assert proc.returncode == exit_codes.FAULT, out
+    (line,) = [x for x in out.splitlines() if x.startswith("error: ")]  # one line, no traceback
+    assert "database" in line and "cannot connect" in line and "Traceback" not in out
     time.sleep(1.0)
     after = joint_positions(rig)
     assert max(abs(a - b) for a, b in zip(before, after, strict=True)) < 1e-3
@@ -130,7 +133,7 @@ def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
     truth = ground_truth(rig)
     assert inject(rig, 0)[0] is True  # DROP_NEXT_GRASP
     code, out = run_batch(rig, db, "E2E-DROP")
-    assert code == 0, out[-3000:]
+    assert code == exit_codes.COMPLETE, out[-3000:]
     recorded = rows(db, "E2E-DROP")
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     # The slip shows up as a drop of a numbered sherd or as one more grasp before numbering.
@@ -157,7 +160,7 @@ def _interrupt_when_weighed(rig, db, context, sig):
 
 def _rerun_finishes_once_each(rig, db, context, truth):
     code, out = run_batch(rig, db, context)
-    assert code == 0, out[-3000:]
+    assert code == exit_codes.COMPLETE, out[-3000:]
     recorded = rows(db, context)
     assert [r["seq"] for r in recorded] == [1, 2, 3]
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
@@ -178,7 +181,7 @@ def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
     )
     truth = ground_truth(rig)
     code, out = run_batch(rig, db, "E2E-TOUCH")
-    assert code == 0, out[-3000:]
+    assert code == exit_codes.COMPLETE, out[-3000:]
     recorded = rows(db, "E2E-TOUCH")
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     _matches_truth(recorded, truth)
@@ -188,7 +191,7 @@ def test_ctrl_c_parks_the_arm_and_a_rerun_finishes_the_batch(rig_factory, db, tm
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
     code, out = _interrupt_when_weighed(rig, db, "E2E-INT", signal.SIGINT)  # what Ctrl-C sends
-    assert code == 130, out[-3000:]
+    assert code == exit_codes.INTERRUPTED, out[-3000:]
     sleep = [0.0, -1.80, 1.55, 0.0, 0.8, 0.0]  # arm.named_poses.sleep of config/rascal.yaml
     assert max(abs(a - b) for a, b in zip(joint_positions(rig), sleep, strict=True)) < 0.05
     # nothing recorded is lost: the sherd in progress is neither done nor lost, only unfinished

@@ -38,6 +38,7 @@ TEST(ControllerParameters, ReadsTheShippedConfiguration) {
   EXPECT_DOUBLE_EQ(c.command_period, 0.02);
   EXPECT_DOUBLE_EQ(c.move.goal_tolerance, 0.002);
   EXPECT_DOUBLE_EQ(c.move.settle_timeout, 2.0);
+  EXPECT_DOUBLE_EQ(c.move.tracking_tolerance, 0.1);
   EXPECT_DOUBLE_EQ(c.state_timeout, 1.0);
   EXPECT_TRUE(c.publish_tf);
   EXPECT_DOUBLE_EQ(c.gripper.timeout, 3.0);

@@ -4,8 +4,9 @@ Without a driver: parameter errors, the IK/FK services, FK, TF and the gripper s
 published /joint_states, goals failing cleanly.
 Against the simulator (`rosrun rascal_sim sim`, skipped until rascal_sim is built): a pose goal
 arrives within 2 mm, an unreachable goal returns UNREACHABLE within 1 s without moving the arm,
-a cancelled move stops, and the gripper reports held on a sherd and not held on nothing (in its
-close results and on /rascal/gripper/state).
+a cancelled move stops, the gripper reports held on a sherd and not held on nothing (in its
+close results and on /rascal/gripper/state), and after a driver restart (/sim/reset) every goal
+is refused with DRIVER_RESTARTED until the restart is acknowledged.
 """
 
 import json
@@ -125,6 +126,8 @@ def test_services_without_a_driver(ros_master, rosrun):
     assert cam["success"] and cam["pose"]["pose"]["position"]["z"] == pytest.approx(0.41565)
     bad = call(ros_master, "/rascal/arm/compute_fk", "{joints: [0, 0], link: ''}")
     assert not bad["success"] and "expected 6" in bad["message"]
+    ack = call(ros_master, "/rascal/arm/acknowledge_restart", "{}")
+    assert ack == {"success": True, "message": "no driver restart to acknowledge"}
     # A top-down pose: the solution reaches it.
     s = math.sqrt(0.5)
     ik = call(
@@ -280,3 +283,15 @@ class TestAgainstTheSimulator:
         # closed on nothing.
         assert out["state_lifted"][0] and out["state_lifted"][1] > 0.032, out
         assert not out["state_opened"][0] and not out["state_empty"][0], out
+
+    def test_a_restarted_driver_is_refused_until_acknowledged(self, rig):
+        out = self.client(rig, "restart")
+        print(out)
+        for name in ("move", "gripper"):
+            assert out[name]["error"] == "DriverRestarted" and out[name]["code"] == 6, out
+            assert out[name]["message"].startswith("arm driver restarted (") and (
+                "re-run `rascal run`" in out[name]["message"]
+            ), out
+        assert "jumped" in out["move"]["message"], out  # the reset pose, with time going on
+        assert out["acknowledged"].startswith("driver restart acknowledged"), out
+        assert out["after"] == 0 and out["again"] == "no driver restart to acknowledge", out

@@ -2,43 +2,62 @@
 controller results to typed results and exceptions. The action clients are injected fakes."""
 
 import math
+import threading
+import time
 
 import pytest
 
 pytest.importorskip("rascal_msgs.msg", reason="rascal_msgs not built (source devel/setup.bash)")
 
 from rascal_msgs.msg import GripperResult as GripperResultMsg  # noqa: E402
-from rascal_msgs.msg import MoveArmResult  # noqa: E402
+from rascal_msgs.msg import MoveArmFeedback, MoveArmResult  # noqa: E402
+from std_srvs.srv import TriggerResponse  # noqa: E402
 
 from rascal_control import (  # noqa: E402
     Arm,
     Collision,
+    DriverRestarted,
     Gripper,
     InvalidGoal,
     Preempted,
     Timeout,
+    TrackingError,
     Unreachable,
 )
+from rascal_control import deadline as dl  # noqa: E402
 from rascal_control.arm import quaternion_from_rpy, to_pose_stamped  # noqa: E402
 
 
 class FakeActionClient:
-    """Records goals and answers with a fixed result."""
+    """Records goals and answers with a fixed result (or never, with `finishes=False`: then it
+    waits as GoalRunner does, until the deadline, the stop event or `alive()` ends it)."""
 
-    def __init__(self, result, finishes=True):
+    def __init__(self, result, finishes=True, alive=None, feedback=None, status=3, text=""):
         self.result = result
+        self.status, self.text = status, text  # actionlib's terminal status (3 SUCCEEDED)
         self.finishes = finishes
+        self.alive = alive
+        self.feedback = feedback
         self.goals = []
         self.cancelled = 0
+        self.deadlines = []
 
     def send_goal(self, goal):
         self.goals.append(goal)
 
-    def wait_for_result(self, timeout):
-        return self.finishes
+    def wait_for_result(self, deadline, stop=None, budget=None):
+        if budget is not None and self.feedback is not None:
+            deadline.seconds = max(deadline.seconds, budget(self.feedback))
+        self.deadlines.append(deadline.seconds)
+        if self.finishes:
+            return dl.DONE
+        return dl.wait_for(lambda: False, deadline, stop, self.alive)
 
     def get_result(self):
         return self.result
+
+    def terminal(self):
+        return self.status, self.text
 
     def cancel_goal(self):
         self.cancelled += 1
@@ -93,7 +112,16 @@ def test_go_and_move_joints_goals():
 
 
 @pytest.mark.parametrize(
-    "code,error", [(1, Unreachable), (2, Collision), (3, Timeout), (4, Preempted), (5, InvalidGoal)]
+    "code,error",
+    [
+        (1, Unreachable),
+        (2, Collision),
+        (3, Timeout),
+        (4, Preempted),
+        (5, InvalidGoal),
+        (6, DriverRestarted),
+        (7, TrackingError),
+    ],
 )
 def test_failures_raise_typed_errors_with_the_reason(code, error):
     arm = Arm(move_client=FakeActionClient(move_result(code, "the reason")))
@@ -103,11 +131,113 @@ def test_failures_raise_typed_errors_with_the_reason(code, error):
     assert info.value.result.duration == 1.5
 
 
+def test_a_goal_the_server_cancelled_unrun_is_never_success():
+    """actionlib's SimpleActionServer cancels a goal stamped before its last one (ROS time went
+    backwards: a restarted simulator) with an empty result: code 0, OK, 0.0 s, no joints."""
+    text = "This goal was canceled because another goal was recieved by the simple action server"
+    empty = MoveArmResult()
+    for status in (2, 8):  # PREEMPTED, RECALLED
+        with pytest.raises(Timeout) as info:
+            Arm(move_client=FakeActionClient(empty, status=status, text=text)).go("home")
+        assert "ended the goal on /rascal/arm/move without running it" in info.value.message
+        assert text in info.value.message
+    with pytest.raises(Timeout):
+        Gripper(client=FakeActionClient(GripperResultMsg(), status=8, text=text)).close()
+
+
 def test_client_side_timeout_cancels():
     client = FakeActionClient(None, finishes=False)
-    with pytest.raises(Timeout):
+    with pytest.raises(Timeout) as info:
         Arm(move_client=client).go("home", timeout=0.1)
     assert client.cancelled == 1
+    assert "arm_controller not answering on /rascal/arm/move" in info.value.message
+    assert info.value.result is None  # the controller never answered
+
+
+TIMINGS = dl.ControllerTimings(
+    settle_timeout=2.0, state_timeout=1.0, gripper_timeout=3.0, margin=5.0
+)
+
+
+def test_the_move_deadline_is_the_planned_duration_plus_settle_timeout_plus_margin():
+    client = FakeActionClient(move_result(0), feedback=MoveArmFeedback(duration=4.0))
+    Arm(move_client=client, timings=TIMINGS).go("home")
+    assert client.deadlines == [pytest.approx(3 * 1.0 + 4.0 + 2.0 + 5.0)]
+    client = FakeActionClient(move_result(0))  # no feedback yet: the controller's waits only
+    Arm(move_client=client, timings=TIMINGS).go("home")
+    assert client.deadlines == [pytest.approx(3 * 1.0 + 2.0 + 5.0)]
+
+
+def test_a_controller_whose_node_is_gone_is_named_at_once():
+    client = FakeActionClient(None, finishes=False, alive=lambda: False)
+    t0 = time.monotonic()
+    with pytest.raises(Timeout) as info:
+        Arm(move_client=client, timings=TIMINGS).go("home")
+    assert time.monotonic() - t0 < 1.5  # one liveness check, not the 10 s deadline
+    assert info.value.message.startswith("arm_controller not answering on /rascal/arm/move")
+    assert "is it running?" in info.value.message
+    assert client.cancelled == 1
+
+
+def test_stop_during_a_move_cancels_it_within_a_slice():
+    stop = threading.Event()
+    client = FakeActionClient(None, finishes=False)
+    threading.Timer(0.2, stop.set).start()
+    t0 = time.monotonic()
+    with pytest.raises(Preempted):
+        Arm(move_client=client, timings=TIMINGS, stop=stop).go("home")
+    assert time.monotonic() - t0 < 0.2 + 0.3
+    assert client.cancelled == 1
+
+
+def test_a_stop_set_before_the_move_does_not_interrupt_it():
+    """Parking after Ctrl-C: the stop event is already set, the park move must still run."""
+    stop = threading.Event()
+    stop.set()
+    client = FakeActionClient(None, finishes=False)
+    with pytest.raises(Timeout):  # it waited for its own deadline instead
+        Arm(move_client=client, stop=stop).go("sleep", timeout=0.3)
+
+
+def test_a_hanging_ik_service_times_out_naming_arm_controller():
+    release = threading.Event()
+
+    def hanging(*_args):
+        release.wait(5.0)
+
+    timings = dl.ControllerTimings(
+        settle_timeout=2.0, state_timeout=0.1, gripper_timeout=3.0, margin=0.2
+    )
+    arm = Arm(move_client=FakeActionClient(None), ik_service=hanging, timings=timings)
+    t0 = time.monotonic()
+    with pytest.raises(Timeout) as info:
+        arm.compute_ik(Arm.top_down(0.3, 0.0, 0.1))
+    release.set()
+    assert time.monotonic() - t0 < 1.0
+    assert info.value.message == (
+        "arm_controller not answering on /rascal/arm/compute_ik within 0.3 s; is it running?"
+    )
+
+
+def test_acknowledge_restart_calls_the_controller():
+    calls = []
+
+    def acknowledge():
+        calls.append(1)
+        return TriggerResponse(success=True, message="driver restart acknowledged (x)")
+
+    arm = Arm(move_client=FakeActionClient(None), acknowledge_service=acknowledge)
+    assert arm.acknowledge_restart() == "driver restart acknowledged (x)"
+    assert calls == [1]
+    assert Arm(move_client=FakeActionClient(None)).acknowledge_restart() == "no acknowledge service"
+
+
+def test_gripper_deadline_and_a_gone_controller():
+    client = FakeActionClient(None, finishes=False, alive=lambda: False)
+    with pytest.raises(Timeout) as info:
+        Gripper(client=client, timings=TIMINGS).close()
+    assert info.value.message.startswith("arm_controller not answering on /rascal/gripper")
+    assert client.deadlines == [pytest.approx(2 * 1.0 + 3.0 + 5.0)]
 
 
 def test_gripper_close_is_truthy_when_holding():

@@ -12,6 +12,7 @@ import rospy
 from sensor_msgs.msg import JointState
 
 from rascal_control import Arm, ControlError, Gripper
+from rascal_control.deadline import Deadline
 
 ARM = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
 
@@ -114,7 +115,7 @@ def cancel(arm):
     client.send_goal(goal)
     rospy.sleep(0.6)
     client.cancel_goal()
-    client.wait_for_result(rospy.Duration(10.0))
+    client.wait_for_result(Deadline(10.0, rospy.get_time))
     result = client.get_result()
     rospy.sleep(0.5)  # braking at the acceleration limit takes < 0.2 s at this speed
     a = joints()
@@ -126,6 +127,28 @@ def cancel(arm):
         "waist": a[0],
         "drift": max(abs(x - y) for x, y in zip(a, b, strict=True)),
     }
+
+
+def restart(arm, gripper):
+    """A driver restart (the simulator's reset puts the arm back at its initial pose at once):
+    every goal is refused until acknowledged; then goals run again."""
+    from std_srvs.srv import Trigger
+
+    arm.go("home")
+    rospy.wait_for_service("/sim/reset", 10.0)
+    rospy.ServiceProxy("/sim/reset", Trigger)()
+    rospy.sleep(0.2)
+    out = {}
+    for name, command in (("move", lambda: arm.go("home")), ("gripper", gripper.open)):
+        try:
+            command()
+            out[name] = None
+        except ControlError as e:
+            out[name] = error_dict(e)
+    out["acknowledged"] = arm.acknowledge_restart()
+    out["after"] = arm.go("home").code
+    out["again"] = arm.acknowledge_restart()
+    return out
 
 
 def gripper_state():
@@ -181,8 +204,8 @@ def main():
     arm, gripper = Arm(wait=30.0), Gripper(wait=30.0)
     scenario = sys.argv[1]
     try:
-        if scenario == "grasp":
-            out = grasp(arm, gripper)
+        if scenario in ("grasp", "restart"):
+            out = {"grasp": grasp, "restart": restart}[scenario](arm, gripper)
         else:
             run = {
                 "pose_goal": pose_goal,

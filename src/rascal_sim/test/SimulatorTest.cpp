@@ -301,6 +301,30 @@ TEST(Simulator, ScaleGlitchMakesReadingsUnstable) {
   EXPECT_NEAR(r.mass, 0.0, 1e-4);
 }
 
+TEST(Simulator, ScaleUnsettledTareAndGlitchOnLoadAreInjectedAndClearedByReset) {
+  Simulator sim(layout(), quiet());
+  std::string message;
+  EXPECT_FALSE(sim.injectFault(static_cast<int>(Fault::kScaleUnsettledTare), 0.0, message));
+  EXPECT_FALSE(sim.injectFault(static_cast<int>(Fault::kScaleGlitchOnLoad), -1.0, message));
+  EXPECT_FALSE(sim.injectFault(5, 1.0, message));
+  ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kScaleUnsettledTare), 1.0, message));
+  ScaleReading r;
+  for (int i = 0; i < 1000; ++i) sim.step();
+  sim.tareScale();
+  for (int i = 0; i < 3000; ++i) sim.step();
+  sim.takeScaleReading(r);
+  EXPECT_NEAR(r.mass, -ScaleSensor::kUnsettledTareError, 1e-4) << "the tare caught the swing";
+  sim.tareScale();
+  ASSERT_TRUE(sim.injectFault(static_cast<int>(Fault::kScaleUnsettledTare), 1.0, message));
+  sim.reset();  // disarms it
+  for (int i = 0; i < 1000; ++i) sim.step();
+  sim.tareScale();
+  for (int i = 0; i < 3000; ++i) sim.step();
+  sim.takeScaleReading(r);
+  EXPECT_NEAR(r.mass, 0.0, 1e-4);
+  EXPECT_TRUE(sim.injectFault(static_cast<int>(Fault::kScaleGlitchOnLoad), 2.0, message));
+}
+
 TEST(Simulator, CameraTimeoutFaultAnswersOnlyAfterItsDuration) {
   Simulator sim(layout(), quiet());
   std::string message;

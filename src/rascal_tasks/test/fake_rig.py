@@ -167,9 +167,12 @@ class _Scale(rig.Scale):
     def tare(self):
         self.w.tare = self._load()
 
-    def read_stable(self, timeout):
-        self.w.t += 1.0
-        return rig.ScaleReading(self._load() - self.w.tare, True)
+    def readings(self, since):
+        """A perfect scale: a steady reading of what lies on it now, every 0.1 s of the clock."""
+        first = math.floor(max(since, self.w.t - 30.0) / 0.1 + 1e-9) + 1
+        last = math.floor(self.w.t / 0.1 + 1e-9)
+        mass = self._load() - self.w.tare
+        return [rig.ScaleReading(mass, True, k * 0.1) for k in range(first, last + 1)]
 
 
 class _Camera(rig.ArchivalCamera):
@@ -200,6 +203,7 @@ class Row:
     status: str = "picked"
     pickup_xy: tuple = (0.0, 0.0)
     mass: Optional[float] = None
+    mass_missing_reason: Optional[str] = None
     image: Optional[str] = None
     lost_reason: Optional[str] = None
     drops: int = 0
@@ -210,10 +214,11 @@ class Recorder:
     """The catalogue's rows and status rules, in memory; `writes` lists every call in order."""
 
     AFTER = {
-        "weighed": ("picked", "weighed"),
-        "photographed": ("weighed", "photographed"),
+        "weighed": ("picked", "mass_unstable", "weighed"),
+        "mass_unstable": ("picked", "mass_unstable"),
+        "photographed": ("mass_unstable", "weighed", "photographed"),
         "done": ("photographed",),
-        "lost": ("picked", "weighed", "photographed"),
+        "lost": ("picked", "mass_unstable", "weighed", "photographed"),
     }
 
     def __init__(self, unfinished=()):
@@ -240,8 +245,14 @@ class Recorder:
     def dimensions(self, seq, length, width, thickness):
         self.writes.append(("dimensions", seq))
 
-    def mass(self, seq, kg, stable, seconds=None):
-        self._move(seq, "weighed").mass = kg
+    def mass(self, seq, kg, stable=True, seconds=None):
+        assert stable, "an unstable reading is never recorded as a mass"
+        row = self._move(seq, "weighed")
+        row.mass, row.mass_missing_reason = kg, None
+
+    def mass_unstable(self, seq, reason, seconds=None):
+        row = self._move(seq, "mass_unstable")
+        row.mass, row.mass_missing_reason = None, reason
 
     def spool_path(self, seq):
         return "/spool/T-%d.png" % seq

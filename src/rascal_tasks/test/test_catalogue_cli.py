@@ -98,7 +98,7 @@ def test_export_refuses_hostile_context_with_one_line(migrated_dsn, bad):
 
 def test_unreachable_database_is_one_line(tmp_path):
     r = rascal("--dsn", "postgresql://rascal:secret@127.0.0.1:1/none", "db", "status")
-    assert r.returncode == 1
+    assert r.returncode == 3  # exit_codes.FAULT
     assert len(r.stderr.strip().splitlines()) == 1
     assert "cannot connect" in r.stderr and "secret" not in r.stderr
 

@@ -40,3 +40,17 @@ def test_sherd_fields_are_carried_over():
     assert o.yaw == pytest.approx(0.6)
     assert (o.grasp_z, o.grasp_width) == (0.01, 0.042)
     assert o.colour == pytest.approx((0.6, 0.4, 0.3))
+
+
+def test_scale_readings_keep_their_stamp_and_flag():
+    from rascal_msgs.msg import ScaleReading as ScaleReadingMsg
+
+    from rascal_tasks.ros_rig import RosScale
+
+    m = ScaleReadingMsg()
+    m.mass, m.stable = 0.0139, True
+    m.header.stamp.secs, m.header.stamp.nsecs = 12, 300000000
+    r = RosScale.reading_from_msg(m, received=99.0)
+    assert (r.mass, r.stable, r.stamp) == (0.0139, True, pytest.approx(12.3))
+    m.header.stamp.secs = m.header.stamp.nsecs = 0  # a driver that does not stamp
+    assert RosScale.reading_from_msg(m, received=99.0).stamp == 99.0

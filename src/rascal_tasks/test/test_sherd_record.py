@@ -88,3 +88,20 @@ def test_a_restart_carries_on_and_numbers_the_next_sherd_after_it(config):
     assert workflow.build_machine(b).execute() == "finished"
     assert rec.status() == {2: "done", 3: "done"}
     assert (b.completed, b.lost) == (2, 0)
+
+
+def test_an_unstable_reading_is_never_a_mass(config):
+    b, _ = _batch(config)
+    s = SherdRecord.picked(b, _obs(0.1, 0.2), b.pickup, attempts=1)
+    with pytest.raises(ValueError, match="record_mass: sherd 1: an unstable reading"):
+        s.record_mass(0.0017, stable=False)
+    s.record_mass_unstable("the reading did not hold")
+    row = b.recorder.sherds[1]
+    assert (row.status, row.mass, row.mass_missing_reason) == (
+        "mass_unstable",
+        None,
+        "the reading did not hold",
+    )
+    assert (s.status, s.mass) == ("mass_unstable", None)
+    s.record_mass(0.0139)  # weighed again, settled
+    assert (row.status, row.mass, row.mass_missing_reason) == ("weighed", 0.0139, None)

@@ -23,7 +23,7 @@ struct ControllerParameters {
   double command_period = 0.02;      // [s] arm.command_period
   double state_timeout = 1.0;        // [s] arm.state_timeout
   bool publish_tf = true;            // arm.publish_tf
-  MoveMonitor::Settings move;        // arm.goal_tolerance, arm.settle_timeout
+  MoveMonitor::Settings move;        // arm.goal_tolerance, arm.settle_timeout, arm.tracking_tolerance
   GripperMonitor::Settings gripper;  // arm.gripper.stroke_time, timeout, held_margin
   std::vector<rascal_workcell::FixtureBox> fixtures;  // Workcell::collisionBoxes() of stations.*
 

@@ -40,6 +40,7 @@ ControllerParameters ControllerParameters::read(const rascal_workcell::Parameter
   c.publish_tf = p.flag("arm.publish_tf");
   c.move.goal_tolerance = p.number("arm.goal_tolerance");
   c.move.settle_timeout = p.number("arm.settle_timeout");
+  c.move.tracking_tolerance = p.number("arm.tracking_tolerance");
   c.gripper.timeout = p.number("arm.gripper.timeout");
   c.gripper.stroke_time = p.number("arm.gripper.stroke_time");
   c.gripper.held_margin = p.number("arm.gripper.held_margin");

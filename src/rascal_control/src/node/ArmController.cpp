@@ -1,5 +1,6 @@
 #include "ArmController.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -29,6 +30,14 @@ ArmController::ArmController(ros::NodeHandle& private_nh) : nh_(private_nh) {
   options.max_acceleration *= params_.acceleration_share;
   planner_ = std::make_unique<TrajectoryPlanner>(*model_, *ik_, collisions_.get(), options);
 
+  DriverMonitor::Settings driver;
+  driver.max_speed = 0.0;
+  for (const JointLimit& limit : model_->limits()) driver.max_speed = std::max(driver.max_speed, limit.velocity);
+  if (!(driver.max_speed > 0.0)) {
+    driver.max_speed = DriverMonitor::Settings{}.max_speed;  // a URDF without velocity limits
+  }
+  states_.configureDriver(driver);
+
   // 2. Topics, services, actions.
   ros::NodeHandle root("/");
   move_server_ = std::make_unique<MoveServer>(root, states_, *model_, *planner_, core_mutex_, params_);
@@ -38,6 +47,9 @@ ArmController::ArmController(ros::NodeHandle& private_nh) : nh_(private_nh) {
                                     ros::TransportHints().tcpNoDelay());
   ik_service_ = root.advertiseService("/rascal/arm/compute_ik", &ArmController::computeIk, this);
   fk_service_ = root.advertiseService("/rascal/arm/compute_fk", &ArmController::computeFk, this);
+  acknowledge_service_ =
+      root.advertiseService("/rascal/arm/acknowledge_restart", &ArmController::acknowledgeRestart, this);
+  driver_timer_ = root.createWallTimer(ros::WallDuration(0.05), &ArmController::watchDriver, this);
   if (params_.publish_tf) {
     std::vector<geometry_msgs::TransformStamped> fixed;
     for (const LinkTransform& t : model_->transforms({}, true)) {
@@ -101,8 +113,26 @@ void ArmController::jointStateCallback(const sensor_msgs::JointState::ConstPtr& 
   }
 }
 
+void ArmController::watchDriver(const ros::WallTimerEvent&) {
+  states_.checkClock();
+  states_.checkSubscribers(move_server_->driverSubscribers());
+  if (states_.restartNoticed()) {
+    ROS_ERROR("arm_controller: %s", restartMessage(states_.restart()).c_str());
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Services
+
+bool ArmController::acknowledgeRestart(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  const std::string reason = states_.acknowledgeRestart();
+  res.success = true;
+  res.message = reason.empty() ? "no driver restart to acknowledge" : "driver restart acknowledged (" + reason + ")";
+  if (!reason.empty()) {
+    ROS_WARN("arm_controller: %s; goals are accepted again", res.message.c_str());
+  }
+  return true;
+}
 
 bool ArmController::computeIk(rascal_msgs::ComputeIK::Request& req, rascal_msgs::ComputeIK::Response& res) {
   try {

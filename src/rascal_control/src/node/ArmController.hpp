@@ -9,6 +9,7 @@
 
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -41,6 +42,9 @@ class ArmController {
   bool computeFk(rascal_msgs::ComputeFK::Request& req, rascal_msgs::ComputeFK::Response& res);
   bool solveIk(rascal_msgs::ComputeIK::Request& req, rascal_msgs::ComputeIK::Response& res);
   bool solveFk(rascal_msgs::ComputeFK::Request& req, rascal_msgs::ComputeFK::Response& res);
+  // Every 50 ms of wall time: ROS time and the driver's subscriptions into the DriverMonitor.
+  void watchDriver(const ros::WallTimerEvent& event);
+  bool acknowledgeRestart(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
 
   ros::NodeHandle nh_;
   std::unique_ptr<KinematicModel> model_;
@@ -55,6 +59,8 @@ class ArmController {
   ros::Subscriber joint_state_sub_;
   ros::ServiceServer ik_service_;
   ros::ServiceServer fk_service_;
+  ros::ServiceServer acknowledge_service_;
+  ros::WallTimer driver_timer_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;
   std::unique_ptr<MoveServer> move_server_;

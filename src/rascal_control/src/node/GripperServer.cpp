@@ -73,6 +73,13 @@ rascal_msgs::GripperResult GripperServer::run(const rascal_msgs::GripperGoal& go
     result.message = target.reason;
     return result;
   }
+  states_.checkClock();
+  const std::string restart = states_.restart();
+  if (!restart.empty()) {
+    result.code = rascal_msgs::GripperResult::DRIVER_RESTARTED;
+    result.message = restartMessage(restart);
+    return result;
+  }
   const std::optional<double> left = states_.waitForFinger(state_timeout_) ? states_.leftFinger() : std::nullopt;
   if (!left) {
     result.code = rascal_msgs::GripperResult::TIMEOUT;
@@ -83,6 +90,13 @@ rascal_msgs::GripperResult GripperServer::run(const rascal_msgs::GripperGoal& go
   if (!driverListening(command_pub_, state_timeout_)) {
     result.code = rascal_msgs::GripperResult::TIMEOUT;
     result.message = "no driver subscribes to /gripper/command; is it running?";
+    return result;
+  }
+  states_.checkClock();
+  const std::string late_restart = states_.restart();
+  if (!late_restart.empty()) {  // noticed while waiting for the fingers or the driver
+    result.code = rascal_msgs::GripperResult::DRIVER_RESTARTED;
+    result.message = restartMessage(late_restart);
     return result;
   }
   const ros::Time t0 = ros::Time::now();
@@ -117,6 +131,13 @@ rascal_msgs::GripperResult GripperServer::run(const rascal_msgs::GripperGoal& go
         return result;
       }
       decision = monitor_.update(result.duration, (ros::WallTime::now() - wall0).toSec());
+    }
+    states_.checkClock();
+    const std::string restarted = states_.restart();
+    if (!restarted.empty()) {
+      result.code = rascal_msgs::GripperResult::DRIVER_RESTARTED;
+      result.message = restartMessage(restarted);
+      return result;
     }
     if (decision.done()) {
       result.code = decision.status == GripperMonitor::Status::Done ? rascal_msgs::GripperResult::OK

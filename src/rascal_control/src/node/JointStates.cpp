@@ -1,10 +1,17 @@
 #include "JointStates.hpp"
 
+#include <cmath>
 #include <limits>
 
 #include "RosConversions.hpp"
 
 namespace rascal_control {
+
+std::string restartMessage(const std::string& reason) {
+  return "arm driver restarted (" + reason + "): the arm may not be where it was and every command was lost; "
+         "goals are refused until the task acknowledges on /rascal/arm/acknowledge_restart: re-run `rascal run` "
+         "to re-calibrate";
+}
 
 std::map<std::string, double> JointStates::update(const sensor_msgs::JointState& msg, const ros::Time& now,
                                                   std::optional<FingerSample>& finger) {
@@ -18,6 +25,12 @@ std::map<std::string, double> JointStates::update(const sensor_msgs::JointState&
     JointVector q{};
     have_arm_ = armJoints(positions_, q);
     last_wall_ = ros::WallTime::now();
+    ++updates_;
+    last_stamp_ = (msg.header.stamp.isZero() ? now : msg.header.stamp).toSec();
+    if (armJoints(positions, q)) {  // this message has the whole arm
+      driver_.addJointState(last_stamp_, q);
+    }
+    driver_.addClock(ros::Time::now().toSec());  // read under the lock: fed in the order read
     all = positions_;
   }
   updated_.notify_all();
@@ -39,6 +52,29 @@ bool JointStates::arm(JointVector& q, double wait) {
   return have_arm_ && armJoints(positions_, q);
 }
 
+bool JointStates::nextArm(JointVector& q, double wait) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const std::uint64_t seen = updates_;
+  updated_.wait_for(lock, std::chrono::duration<double>(wait), [&] { return updates_ != seen && have_arm_; });
+  return updates_ != seen && have_arm_ && armJoints(positions_, q);
+}
+
+bool JointStates::armAtRest(JointVector& q, double at_rest, double wait) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto resting = [&] {
+    for (const std::string& name : KinematicModel::armJointNames()) {
+      const auto v = velocities_.find(name);
+      if (v != velocities_.end() && !(std::fabs(v->second) < at_rest)) {
+        return false;
+      }
+    }
+    return true;
+  };
+  const bool rest = updated_.wait_for(lock, std::chrono::duration<double>(wait), resting);
+  armJoints(positions_, q);
+  return rest;
+}
+
 ArmSample JointStates::armSample(std::chrono::milliseconds wait) {
   std::unique_lock<std::mutex> lock(mutex_);
   updated_.wait_for(lock, wait);
@@ -49,6 +85,7 @@ ArmSample JointStates::armSample(std::chrono::milliseconds wait) {
     s.velocity[j] = v != velocities_.end() ? v->second : 0.0;  // none reported: only the position counts
   }
   s.state_age = (ros::WallTime::now() - last_wall_).toSec();
+  s.measured = last_stamp_;
   return s;
 }
 
@@ -67,6 +104,38 @@ bool JointStates::waitForFinger(double wait) {
 void JointStates::waitForUpdate(std::chrono::milliseconds wait) {
   std::unique_lock<std::mutex> lock(mutex_);
   updated_.wait_for(lock, wait);
+}
+
+void JointStates::checkClock() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  driver_.addClock(ros::Time::now().toSec());  // read under the lock: fed in the order read
+}
+
+void JointStates::checkSubscribers(int count) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  driver_.addSubscribers(count);
+}
+
+std::string JointStates::restart() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return driver_.restarted() ? driver_.reason() : std::string();
+}
+
+bool JointStates::restartNoticed() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!driver_.restarted() || restart_logged_) {
+    return false;
+  }
+  restart_logged_ = true;
+  return true;
+}
+
+std::string JointStates::acknowledgeRestart() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string reason = driver_.reason();
+  driver_.acknowledge();
+  restart_logged_ = false;
+  return reason;
 }
 
 }  // namespace rascal_control

@@ -1,12 +1,28 @@
 #include "MoveServer.hpp"
 
 #include <chrono>
+#include <cstdio>
 
 #include <trajectory_msgs/JointTrajectory.h>
 
 #include "RosConversions.hpp"
 
 namespace rascal_control {
+
+namespace {
+
+uint8_t resultCode(MoveMonitor::Status status) {
+  switch (status) {
+    case MoveMonitor::Status::Arrived:
+      return rascal_msgs::MoveArmResult::OK;
+    case MoveMonitor::Status::OffPath:
+      return rascal_msgs::MoveArmResult::TRACKING_ERROR;
+    default:
+      return rascal_msgs::MoveArmResult::TIMEOUT;
+  }
+}
+
+}  // namespace
 
 MoveServer::MoveServer(ros::NodeHandle& root, JointStates& states, const KinematicModel& model,
                        TrajectoryPlanner& planner, std::mutex& core_mutex, const ControllerParameters& params)
@@ -102,15 +118,29 @@ PlanResult MoveServer::plan(const rascal_msgs::MoveArmGoal& goal, const JointVec
   return planner_.planJoint(start, target_joints, scale);
 }
 
+int MoveServer::driverSubscribers() const { return static_cast<int>(command_pub_.getNumSubscribers()); }
+
 rascal_msgs::MoveArmResult MoveServer::run(const rascal_msgs::MoveArmGoal& goal) {
   rascal_msgs::MoveArmResult result;
-  JointVector start{};
-  if (!states_.arm(start, params_.state_timeout)) {
-    result.code = rascal_msgs::MoveArmResult::TIMEOUT;
-    result.message = "no arm joints on /joint_states within " + std::to_string(params_.state_timeout) +
-                     " s; is the driver running?";
+  states_.checkClock();
+  const std::string restart = states_.restart();
+  if (!restart.empty()) {
+    result.code = rascal_msgs::MoveArmResult::DRIVER_RESTARTED;
+    result.message = restartMessage(restart);
     return result;
   }
+  JointVector start{};
+  if (!states_.nextArm(start, params_.state_timeout)) {  // planned from where the arm is now
+    result.code = rascal_msgs::MoveArmResult::TIMEOUT;
+    char text[120];
+    std::snprintf(text, sizeof(text), "no arm joints on /joint_states within %.1f s; is the driver running?",
+                  params_.state_timeout);
+    result.message = text;
+    return result;
+  }
+  // A cancelled move may still be braking: plan from where the arm comes to rest (after
+  // state_timeout from where it is; the tracking rule judges the rest).
+  states_.armAtRest(start, MoveMonitor::kAtRest, params_.state_timeout);
   result.joints = toStdVector(start);
   const PlanResult planned = plan(goal, start);
   if (!planned.ok()) {
@@ -119,10 +149,20 @@ rascal_msgs::MoveArmResult MoveServer::run(const rascal_msgs::MoveArmGoal& goal)
     return result;
   }
   const Trajectory& trajectory = planned.trajectory;
-  const MoveMonitor monitor(trajectory.goal(), trajectory.duration(), params_.move);
+  const MoveMonitor monitor(MoveMonitor::reference(trajectory), params_.move);
   if (!driverListening(command_pub_, params_.state_timeout)) {
     result.code = rascal_msgs::MoveArmResult::TIMEOUT;
     result.message = "no driver subscribes to /arm/joint_trajectory; is it running?";
+    return result;
+  }
+  // The restart rule once more, right before sending: a driver that has just subscribed again
+  // (restarted) must not get a trajectory planned for the arm it had before.
+  states_.checkSubscribers(driverSubscribers());
+  states_.checkClock();
+  const std::string late_restart = states_.restart();
+  if (!late_restart.empty()) {
+    result.code = rascal_msgs::MoveArmResult::DRIVER_RESTARTED;
+    result.message = restartMessage(late_restart);
     return result;
   }
   const ros::Time t0 = ros::Time::now();
@@ -136,6 +176,7 @@ rascal_msgs::MoveArmResult MoveServer::run(const rascal_msgs::MoveArmGoal& goal)
     ArmSample sample = states_.armSample(std::chrono::milliseconds(5));
     const ros::Time now = ros::Time::now();
     sample.elapsed = (now - t0).toSec();
+    sample.measured -= t0.toSec();
     sample.wall = (ros::WallTime::now() - wall0).toSec();
     result.joints = toStdVector(sample.q);
     result.duration = sample.elapsed;
@@ -145,17 +186,25 @@ rascal_msgs::MoveArmResult MoveServer::run(const rascal_msgs::MoveArmGoal& goal)
       result.message = "move cancelled; arm stopped";
       return result;
     }
+    states_.checkClock();
+    const std::string restarted = states_.restart();
+    if (!restarted.empty()) {  // before any decision: the samples may be the restarted driver's
+      command_pub_.publish(stopTrajectory(now));
+      result.code = rascal_msgs::MoveArmResult::DRIVER_RESTARTED;
+      result.message = restartMessage(restarted);
+      return result;
+    }
     const MoveMonitor::Decision decision = monitor.update(sample);
     if (decision.done()) {
       if (decision.status != MoveMonitor::Status::Arrived) {
         command_pub_.publish(stopTrajectory(now));
       }
-      result.code = decision.status == MoveMonitor::Status::Arrived ? rascal_msgs::MoveArmResult::OK
-                                                                     : rascal_msgs::MoveArmResult::TIMEOUT;
+      result.code = resultCode(decision.status);
       result.message = decision.reason;
       return result;
     }
-    if ((now - last_feedback).toSec() >= 0.05 || now < last_feedback) {
+    if ((now - last_feedback).toSec() >= 0.05 || now < last_feedback || last_feedback.isZero()) {
+      feedback.duration = monitor.duration();
       feedback.progress = monitor.progress(sample.elapsed);
       feedback.joints = result.joints;
       server_->publishFeedback(feedback);

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <mutex>
+#include <string>
 
 #include <actionlib/server/simple_action_server.h>
 #include <ros/ros.h>
@@ -22,6 +23,9 @@ class MoveServer {
   // and collision checker it uses, shared with the node's services). Starts the action server.
   MoveServer(ros::NodeHandle& root, JointStates& states, const KinematicModel& model, TrajectoryPlanner& planner,
              std::mutex& core_mutex, const ControllerParameters& params);
+
+  // Subscribers of /arm/joint_trajectory (the driver's; DriverMonitor's rule).
+  int driverSubscribers() const;
 
  private:
   void execute(const rascal_msgs::MoveArmGoalConstPtr& goal);

@@ -11,6 +11,9 @@
     print(held.width)
 
 Failures raise a subclass of ControlError carrying the controller's code and one-line reason.
+Every wait has a deadline (`deadline.py`): a controller that does not answer, or whose node is
+gone, raises Timeout naming arm_controller; a `stop` event set during a wait cancels the goal and
+raises Preempted.
 """
 
 from rascal_control.arm import Arm
@@ -18,11 +21,13 @@ from rascal_control.gripper import Gripper
 from rascal_control.results import (
     Collision,
     ControlError,
+    DriverRestarted,
     GripperResult,
     InvalidGoal,
     MoveResult,
     Preempted,
     Timeout,
+    TrackingError,
     Unreachable,
 )
 
@@ -37,4 +42,6 @@ __all__ = [
     "Timeout",
     "Preempted",
     "InvalidGoal",
+    "DriverRestarted",
+    "TrackingError",
 ]

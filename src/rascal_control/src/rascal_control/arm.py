@@ -1,9 +1,22 @@
 """rascal_control.Arm: move the arm by pose, named pose or joints through /rascal/arm/move."""
 
 import math
+import threading
 from typing import Optional, Sequence
 
-from rascal_control.results import OK, MoveResult, Timeout, ik_error, move_error
+from rascal_control import deadline as dl
+from rascal_control.results import (
+    GOAL_SUCCEEDED,
+    OK,
+    PREEMPTED,
+    TIMEOUT,
+    MoveResult,
+    Preempted,
+    Timeout,
+    ik_error,
+    move_error,
+    unrun_goal,
+)
 
 ARM_JOINTS = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
 MOTIONS = {"joint": 0, "linear": 1}
@@ -59,34 +72,58 @@ def to_pose_stamped(pose):
 class Arm:
     """PyRobot-like arm client. Needs rospy.init_node() first (unless clients are injected).
 
-    Every move returns a MoveResult or raises Unreachable, Collision, Timeout, Preempted or
-    InvalidGoal with the controller's one-line reason.
+    Every move returns a MoveResult or raises Unreachable, Collision, Timeout, Preempted,
+    InvalidGoal, DriverRestarted or TrackingError with the controller's one-line reason. Every
+    wait has a deadline from `timings` (deadline.ControllerTimings; default: the schema's
+    defaults): a controller that does not answer in time, or whose node is gone, raises Timeout
+    naming arm_controller. `stop` (a threading.Event, e.g. the task's Ctrl-C) set during a wait
+    cancels the goal and raises Preempted within deadline.SLICE seconds.
     """
 
-    def __init__(self, move_client=None, ik_service=None, fk_service=None, wait: float = 10.0):
+    def __init__(
+        self,
+        move_client=None,
+        ik_service=None,
+        fk_service=None,
+        wait: float = 10.0,
+        timings: Optional[dl.ControllerTimings] = None,
+        stop: Optional[threading.Event] = None,
+        acknowledge_service=None,
+        ros_now=None,
+    ):
+        self.timings = timings or dl.ControllerTimings.defaults()
+        self.stop_event = stop
+        self._ros_now = ros_now or dl.ros_time
         if move_client is None:
             import rospy
             from rascal_msgs.msg import MoveArmAction
             from rascal_msgs.srv import ComputeFK, ComputeIK
+            from std_srvs.srv import Trigger
 
             from rascal_control.goal_runner import GoalRunner
 
             move_client = GoalRunner("/rascal/arm/move", MoveArmAction)
-            if not move_client.wait_for_server(rospy.Duration(wait)):
+            if not move_client.wait_for_server(rospy.Duration(wait), stop):
                 raise Timeout(
-                    3,
+                    TIMEOUT,
                     "no /rascal/arm/move action server within %.0f s; is "
                     "arm_controller running?" % wait,
                 )
             try:
                 rospy.wait_for_service("/rascal/arm/compute_ik", wait)
             except rospy.ROSException as e:
-                raise Timeout(3, "no /rascal/arm/compute_ik service within %.0f s" % wait) from e
+                raise Timeout(
+                    TIMEOUT,
+                    "no /rascal/arm/compute_ik service within %.0f s; is arm_controller running?"
+                    % wait,
+                ) from e
             ik_service = rospy.ServiceProxy("/rascal/arm/compute_ik", ComputeIK)
             fk_service = rospy.ServiceProxy("/rascal/arm/compute_fk", ComputeFK)
+            acknowledge_service = rospy.ServiceProxy("/rascal/arm/acknowledge_restart", Trigger)
         self._move = move_client
         self._ik = ik_service
         self._fk = fk_service
+        self._acknowledge = acknowledge_service
         self.last_result: Optional[MoveResult] = None
 
     # -- goals ------------------------------------------------------------------------------
@@ -138,7 +175,9 @@ class Arm:
     # -- kinematics -------------------------------------------------------------------------
     def compute_ik(self, pose, seed: Optional[Sequence[float]] = None):
         """Joint vector for `pose`, closest to `seed` (default: the current joints)."""
-        response = self._ik(to_pose_stamped(pose), list(seed or []))
+        response = self._call(
+            self._ik, "/rascal/arm/compute_ik", to_pose_stamped(pose), list(seed or [])
+        )
         if response.code != OK:
             raise ik_error(response.code, response.message)
         return list(response.joints)
@@ -146,10 +185,19 @@ class Arm:
     def compute_fk(self, joints: Optional[Sequence[float]] = None, link: str = ""):
         """PoseStamped of `link` (default ee_gripper_link) in base_link; joints default to the
         current ones."""
-        response = self._fk(list(joints or []), link)
+        response = self._call(self._fk, "/rascal/arm/compute_fk", list(joints or []), link)
         if not response.success:
             raise move_error(5, response.message)
         return response.pose
+
+    def acknowledge_restart(self) -> str:
+        """Tell the controller the task knows the driver restarted (it re-calibrates now): goals
+        are accepted again. Returns the controller's one line ("no driver restart to
+        acknowledge" when there was none). A no-op without the service (injected clients)."""
+        if self._acknowledge is None:
+            return "no acknowledge service"
+        response = self._call(self._acknowledge, "/rascal/arm/acknowledge_restart")
+        return response.message
 
     def get_ee_pose(self):
         """Current PoseStamped of ee_gripper_link."""
@@ -169,19 +217,62 @@ class Arm:
         goal.speed_scale = float(speed_scale)
         return goal
 
-    def _run(self, goal, timeout: Optional[float]) -> MoveResult:
+    def _call(self, service, name: str, *args):
+        """A service of the controller, with the deadline timings.service()."""
         import rospy
 
-        self._move.send_goal(goal)
-        finished = self._move.wait_for_result(rospy.Duration(timeout or 0.0))
-        if not finished:
-            self._move.cancel_goal()
+        deadline = dl.Deadline(self.timings.service(), self._ros_now)
+        try:
+            return dl.call(service, *args, deadline=deadline, stop=self.stop_event)
+        except dl.Unfinished as e:
+            if e.outcome == dl.STOPPED:
+                raise Preempted(PREEMPTED, "stop requested while waiting for %s" % name) from None
             raise Timeout(
-                3, "no result from /rascal/arm/move within %.1f s; move cancelled" % timeout
+                TIMEOUT,
+                "arm_controller not answering on %s within %.1f s; is it running?"
+                % (name, deadline.seconds),
+            ) from None
+        except rospy.ServiceException as e:  # the node is gone, or failed on this request
+            raise Timeout(
+                TIMEOUT,
+                "arm_controller not answering on %s (%s); is it running?"
+                % (name, str(e).splitlines()[0] if str(e) else type(e).__name__),
+            ) from None
+
+    def _run(self, goal, timeout: Optional[float]) -> MoveResult:
+        """Send `goal` and wait: `timeout` seconds (ROS and wall time), or by default the
+        controller's own deadline (the planned duration + arm.settle_timeout, from the goal's
+        feedback) plus rig.answer_margin."""
+        self._move.send_goal(goal)
+        deadline = dl.Deadline(
+            timeout if timeout is not None else self.timings.move(), self._ros_now
+        )
+        budget = None if timeout is not None else (lambda fb: self.timings.move(fb.duration))
+        outcome = self._move.wait_for_result(deadline, self.stop_event, budget)
+        if outcome != dl.DONE:
+            self._move.cancel_goal()
+            if outcome == dl.STOPPED:
+                raise Preempted(PREEMPTED, "stop requested: move cancelled")
+            if outcome == dl.GONE:
+                raise Timeout(
+                    TIMEOUT,
+                    "arm_controller not answering on /rascal/arm/move (its node does not "
+                    "respond); is it running? (rosrun rascal_control arm_controller)",
+                )
+            raise Timeout(
+                TIMEOUT,
+                "arm_controller not answering on /rascal/arm/move: no result %.1f s after the "
+                "goal; is it running?" % deadline.seconds,
             )
         msg = self._move.get_result()
+        status, text = self._move.terminal()
+        if msg is not None and msg.code == OK and status != GOAL_SUCCEEDED:
+            raise unrun_goal("/rascal/arm/move", status, text)
         if msg is None:
-            raise Timeout(3, "/rascal/arm/move ended without a result (controller gone?)")
+            raise Timeout(
+                TIMEOUT,
+                "/rascal/arm/move ended without a result (arm_controller restarted or gone?)",
+            )
         result = MoveResult(msg.code, msg.message, msg.duration, list(msg.joints))
         self.last_result = result
         if msg.code != OK:

@@ -1,16 +1,41 @@
 """rascal_control.Gripper: open, close or set the gripper through /rascal/gripper."""
 
+import threading
 from typing import Optional
 
+from rascal_control import deadline as dl
 from rascal_control.gripper_limits import opening_limits
-from rascal_control.results import OK, GripperResult, Timeout, move_error
+from rascal_control.results import (
+    GOAL_SUCCEEDED,
+    OK,
+    PREEMPTED,
+    TIMEOUT,
+    GripperResult,
+    Preempted,
+    Timeout,
+    move_error,
+    unrun_goal,
+)
 
 
 class Gripper:
     """PyRobot-like gripper client. `close()` returns a GripperResult that is truthy when an
-    object is held; failures raise Timeout, Preempted or InvalidGoal."""
+    object is held; failures raise Timeout, Preempted, InvalidGoal or DriverRestarted. Every
+    wait has a deadline (timings.gripper(): arm.gripper.timeout + margin); a controller that
+    does not answer, or whose node is gone, raises Timeout naming arm_controller; `stop` set
+    during a wait cancels the command and raises Preempted."""
 
-    def __init__(self, client=None, wait: float = 10.0):
+    def __init__(
+        self,
+        client=None,
+        wait: float = 10.0,
+        timings: Optional[dl.ControllerTimings] = None,
+        stop: Optional[threading.Event] = None,
+        ros_now=None,
+    ):
+        self.timings = timings or dl.ControllerTimings.defaults()
+        self.stop_event = stop
+        self._ros_now = ros_now or dl.ros_time
         if client is None:
             import rospy
             from rascal_msgs.msg import GripperAction
@@ -18,9 +43,9 @@ class Gripper:
             from rascal_control.goal_runner import GoalRunner
 
             client = GoalRunner("/rascal/gripper", GripperAction)
-            if not client.wait_for_server(rospy.Duration(wait)):
+            if not client.wait_for_server(rospy.Duration(wait), stop):
                 raise Timeout(
-                    3,
+                    TIMEOUT,
                     "no /rascal/gripper action server within %.0f s; is "
                     "arm_controller running?" % wait,
                 )
@@ -51,17 +76,38 @@ class Gripper:
         return self._run(2, width, timeout)
 
     def _run(self, command: int, width: float, timeout: Optional[float]) -> GripperResult:
-        import rospy
         from rascal_msgs.msg import GripperGoal
 
         goal = GripperGoal(command=command, width=float(width))
         self._client.send_goal(goal)
-        if not self._client.wait_for_result(rospy.Duration(timeout or 0.0)):
+        deadline = dl.Deadline(
+            timeout if timeout is not None else self.timings.gripper(), self._ros_now
+        )
+        outcome = self._client.wait_for_result(deadline, self.stop_event)
+        if outcome != dl.DONE:
             self._client.cancel_goal()
-            raise Timeout(3, "no result from /rascal/gripper within %.1f s; cancelled" % timeout)
+            if outcome == dl.STOPPED:
+                raise Preempted(PREEMPTED, "stop requested: gripper command cancelled")
+            if outcome == dl.GONE:
+                raise Timeout(
+                    TIMEOUT,
+                    "arm_controller not answering on /rascal/gripper (its node does not "
+                    "respond); is it running? (rosrun rascal_control arm_controller)",
+                )
+            raise Timeout(
+                TIMEOUT,
+                "arm_controller not answering on /rascal/gripper: no result %.1f s after the "
+                "command; is it running?" % deadline.seconds,
+            )
         msg = self._client.get_result()
+        status, text = self._client.terminal()
+        if msg is not None and msg.code == OK and status != GOAL_SUCCEEDED:
+            raise unrun_goal("/rascal/gripper", status, text)
         if msg is None:
-            raise Timeout(3, "/rascal/gripper ended without a result (controller gone?)")
+            raise Timeout(
+                TIMEOUT,
+                "/rascal/gripper ended without a result (arm_controller restarted or gone?)",
+            )
         result = GripperResult(msg.code, msg.message, msg.width, msg.holding, msg.duration)
         self.last_result = result
         if msg.code != OK:

@@ -10,6 +10,8 @@ COLLISION = 2
 TIMEOUT = 3
 PREEMPTED = 4
 INVALID_GOAL = 5
+DRIVER_RESTARTED = 6  # MoveArm and Gripper: refused until the restart is acknowledged
+TRACKING_ERROR = 7  # MoveArm: the arm left its planned path; it was stopped
 IK_JOINT_LIMIT = 2
 IK_SINGULAR = 3
 IK_INVALID = 4
@@ -45,12 +47,23 @@ class InvalidGoal(ControlError):
     """The request itself is malformed (frame, quaternion, unknown named pose, width range)."""
 
 
+class DriverRestarted(ControlError):
+    """The arm driver (or simulator) restarted: the controller refuses every goal until the task
+    acknowledges it (`Arm.acknowledge_restart()`, which `rascal run` calls when it starts)."""
+
+
+class TrackingError(ControlError):
+    """The arm left its planned path by more than arm.tracking_tolerance; it was stopped."""
+
+
 _MOVE_ERRORS = {
     UNREACHABLE: Unreachable,
     COLLISION: Collision,
     TIMEOUT: Timeout,
     PREEMPTED: Preempted,
     INVALID_GOAL: InvalidGoal,
+    DRIVER_RESTARTED: DriverRestarted,
+    TRACKING_ERROR: TrackingError,
 }
 _IK_ERRORS = {
     UNREACHABLE: Unreachable,
@@ -58,6 +71,31 @@ _IK_ERRORS = {
     IK_SINGULAR: Unreachable,
     IK_INVALID: InvalidGoal,
 }
+
+
+GOAL_SUCCEEDED = 3  # actionlib_msgs/GoalStatus.SUCCEEDED
+GOAL_STATUS_NAMES = {
+    0: "PENDING",
+    1: "ACTIVE",
+    2: "PREEMPTED",
+    3: "SUCCEEDED",
+    4: "ABORTED",
+    5: "REJECTED",
+    6: "PREEMPTING",
+    7: "RECALLING",
+    8: "RECALLED",
+    9: "LOST",
+}
+
+
+def unrun_goal(action: str, status: int, text: str) -> "Timeout":
+    """A goal the server ended without running it (an empty result says code 0, OK, in 0.0 s:
+    never taken as success)."""
+    return Timeout(
+        TIMEOUT,
+        "arm_controller ended the goal on %s without running it (%s: %s); is another client "
+        "sending goals to it?" % (action, GOAL_STATUS_NAMES.get(status, str(status)), text),
+    )
 
 
 def move_error(code: int, message: str, result=None) -> ControlError:

@@ -40,7 +40,14 @@ struct WristFrame {
   bool blurred = false;
 };
 
-enum class Fault { kDropNextGrasp = 0, kScaleGlitch = 1, kCameraTimeout = 2 };
+/// Faults for tests (rascal_msgs/InjectFault): the codes of the service.
+enum class Fault {
+  kDropNextGrasp = 0,
+  kScaleGlitch = 1,
+  kCameraTimeout = 2,
+  kScaleUnsettledTare = 3,  ///< the next tare catches the platform swinging (ScaleSensor)
+  kScaleGlitchOnLoad = 4,   ///< a glitch from when the next sherd lands on the scale
+};
 
 class Simulator {
  public:

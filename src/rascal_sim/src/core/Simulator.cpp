@@ -61,6 +61,7 @@ void Simulator::reset() {
   rng_.seed(scenario_.seed);
   slip_armed_ = false;
   drop_next_grasp_ = false;
+  scale_.clearFaults();
   close_armed_ = false;
   open_requested_ = false;
 }
@@ -241,6 +242,8 @@ bool Simulator::injectFault(int fault, double duration, std::string& message) {
       return true;
     case static_cast<int>(Fault::kScaleGlitch):
     case static_cast<int>(Fault::kCameraTimeout):
+    case static_cast<int>(Fault::kScaleUnsettledTare):
+    case static_cast<int>(Fault::kScaleGlitchOnLoad):
       if (!(duration > 0.0)) {
         message = "duration must be > 0 s for this fault";
         return false;
@@ -248,13 +251,22 @@ bool Simulator::injectFault(int fault, double duration, std::string& message) {
       if (fault == static_cast<int>(Fault::kScaleGlitch)) {
         scale_.glitch(time() + duration);
         message = "scale readings are garbage and unstable for " + std::to_string(duration) + " s";
+      } else if (fault == static_cast<int>(Fault::kScaleUnsettledTare)) {
+        scale_.unsettledNextTare(duration);
+        message = "the next tare catches the platform swinging: zero 3 g high, readings drift 3 g low over " +
+                  std::to_string(duration) + " s";
+      } else if (fault == static_cast<int>(Fault::kScaleGlitchOnLoad)) {
+        scale_.glitchOnNextLoad(duration);
+        message = "scale readings are garbage and unstable for " + std::to_string(duration) +
+                  " s from when the next sherd lands on the scale";
       } else {
         camera_fault_until_ = time() + duration;
         message = "archival camera does not answer for " + std::to_string(duration) + " s";
       }
       return true;
     default:
-      message = "unknown fault " + std::to_string(fault) + " (0 drop, 1 scale glitch, 2 camera timeout)";
+      message = "unknown fault " + std::to_string(fault) +
+                " (0 drop, 1 scale glitch, 2 camera timeout, 3 scale unsettled tare, 4 scale glitch on load)";
       return false;
   }
 }

@@ -5,11 +5,14 @@
     rascal export --context ID --format csv|json [--output FILE]
     rascal run --context ID                one batch on the rig (config from the parameter server)
     rascal report --context ID             HTML page: thumbnails, measurements, time breakdown
+    rascal verify [--context ID] [--repair] the image archive checked against the catalogue
 
 The database comes from ``--dsn``, else ``$RASCAL_DSN``, else ``database.dsn`` of the site
-config (``--config``, else ``$RASCAL_CONFIG``, else ``config/rascal.yaml`` of the workspace),
-else the default DSN below. Errors are one line on stderr; exit status 0 = done,
-1 = failed (or, for ``db status``, schema not up to date), 2 = bad arguments or config.
+config (``--config``, else ``$RASCAL_CONFIG``, else config/rascal.yaml of the workspace; for
+``rascal run`` else the parameter server's), else the default DSN below (`resolve_database`, one
+path for every verb). Errors are one line on stderr. Exit status (exit_codes.py): 0 done,
+1 incomplete (``run``: sherds left or lost; ``db status``: schema not up to date), 2 bad
+arguments, config or context, 3 a fault (database, rig, archive), 4 busy, 130 interrupted.
 
 To add a subcommand: write ``_add_<name>(subparsers)`` that creates its parser and sets
 ``func``, and call it in ``build_parser``.
@@ -20,6 +23,8 @@ import os
 import re
 import sys
 import tempfile
+
+from rascal_tasks import exit_codes
 
 DEFAULT_DSN = "postgresql://rascal:rascal@127.0.0.1:5432/rascal"
 _WORKSPACE_CONFIG = os.path.normpath(
@@ -33,7 +38,7 @@ class UsageError(Exception):
     """Bad arguments or configuration (exit status 2)."""
 
 
-def _mask(dsn):
+def mask_dsn(dsn):
     """The DSN with its password replaced by ***."""
     dsn = re.sub(r"(://[^:/@]*:)[^@]*@", r"\1***@", dsn)
     return re.sub(r"(password\s*=\s*)\S+", r"\1***", dsn)
@@ -49,8 +54,13 @@ def load_site_config(path):
         raise UsageError(str(e)) from None
 
 
+def explicit_config_path(args):
+    """The site config the user named (``--config``, else ``$RASCAL_CONFIG``), or None."""
+    return args.config or os.environ.get("RASCAL_CONFIG") or None
+
+
 def _config_path(args):
-    path = args.config or os.environ.get("RASCAL_CONFIG")
+    path = explicit_config_path(args)
     if path:
         return path
     for candidate in (os.path.join("config", "rascal.yaml"), _WORKSPACE_CONFIG):
@@ -59,18 +69,21 @@ def _config_path(args):
     return None
 
 
-def resolve_database(args):
-    """``(dsn, connect_timeout, where_it_came_from)``."""
+def resolve_database(args, cfg=None):
+    """``(dsn, connect_timeout, where_it_came_from)``: ``--dsn``, else ``$RASCAL_DSN``, else
+    ``database.dsn`` of `cfg` (the configuration a run already loaded) or of the site config
+    file, else DEFAULT_DSN. The connect timeout is the config's when there is one."""
+    if cfg is None and not (args.dsn or os.environ.get("RASCAL_DSN")):
+        path = _config_path(args)
+        cfg = load_site_config(path) if path else None
+    timeout = float(cfg["database"].get("connect_timeout", 5.0)) if cfg is not None else 5.0
     if args.dsn:
-        return args.dsn, 5.0, "--dsn"
+        return args.dsn, timeout, "--dsn"
     if os.environ.get("RASCAL_DSN"):
-        return os.environ["RASCAL_DSN"], 5.0, "RASCAL_DSN"
-    path = _config_path(args)
-    if path:
-        cfg = load_site_config(path)
-        db = cfg["database"]
-        return db["dsn"], float(db.get("connect_timeout", 5.0)), path
-    return DEFAULT_DSN, 5.0, "default"
+        return os.environ["RASCAL_DSN"], timeout, "RASCAL_DSN"
+    if cfg is not None:
+        return cfg["database"]["dsn"], timeout, cfg.source
+    return DEFAULT_DSN, timeout, "default"
 
 
 def connect(args):
@@ -84,7 +97,7 @@ def connect(args):
     except psycopg2.OperationalError as e:
         first = (str(e).strip().splitlines() or ["unknown error"])[0]
         raise RuntimeError(
-            "database %s (from %s): cannot connect: %s" % (_mask(dsn), source, first)
+            "database %s (from %s): cannot connect: %s" % (mask_dsn(dsn), source, first)
         ) from None
     return conn, dsn, source
 
@@ -100,10 +113,11 @@ def cmd_db_migrate(args, out):
         conn.close()
     if done:
         print(
-            "migrated %s to version %d (%d applied)" % (_mask(dsn), done[-1], len(done)), file=out
+            "migrated %s to version %d (%d applied)" % (mask_dsn(dsn), done[-1], len(done)),
+            file=out,
         )
     else:
-        print("%s: already up to date" % _mask(dsn), file=out)
+        print("%s: already up to date" % mask_dsn(dsn), file=out)
     return 0
 
 
@@ -122,7 +136,7 @@ def cmd_db_status(args, out):
                 counts = cur.fetchone()
     finally:
         conn.close()
-    print("database  %s (from %s), PostgreSQL %s" % (_mask(dsn), source, version), file=out)
+    print("database  %s (from %s), PostgreSQL %s" % (mask_dsn(dsn), source, version), file=out)
     for v, name, applied_at, state in rows:
         when = applied_at.strftime("%Y-%m-%d %H:%M:%S %Z") if applied_at else ""
         print("  %04d_%-24s %-8s %s" % (v, name, state, when), file=out)
@@ -175,7 +189,11 @@ def cmd_export(args, out):
 def cmd_run(args, out):
     from rascal_tasks.run_batch import run
 
-    return run(args.context, dsn=args.dsn)
+    return run(
+        args.context,
+        config_path=explicit_config_path(args),
+        database=lambda cfg: resolve_database(args, cfg),
+    )
 
 
 def cmd_report(args, out):
@@ -217,6 +235,71 @@ def cmd_report(args, out):
     report = write_report(args.context, records, archive, summary)
     print("report: %s" % report, file=out)
     return 0
+
+
+# --- verify ---
+def cmd_verify(args, out):
+    """The image archive against the catalogue: one line per problem (exit 1), none (exit 0).
+    --repair first rewrites what the catalogue can rewrite (stale or missing sidecars, old
+    temporary files); a missing or changed image is left for a person."""
+    from rascal_tasks.catalogue import Catalogue, ImageArchive, validate_context_id
+    from rascal_tasks.catalogue import repair_archive, verify_archive
+
+    if args.context is not None:
+        validate_context_id(args.context)
+    # the site config, unless --archive and --dsn / $RASCAL_DSN say everything it would
+    needed = explicit_config_path(args) or not (
+        args.archive and (args.dsn or os.environ.get("RASCAL_DSN"))
+    )
+    path = _config_path(args) if needed else None
+    cfg = load_site_config(path) if path else None
+    if args.archive is None and cfg is None:
+        raise UsageError("no site config found; pass --config config/rascal.yaml or --archive")
+    archive = ImageArchive(args.archive or cfg.resolve(cfg["archive"]["root"]))
+    dsn, timeout, source = resolve_database(args, cfg)
+    cat = Catalogue.connect(
+        dsn,
+        rig=cfg["rig"]["name"] if cfg is not None else "rascal-cli",
+        config_hash=cfg.hash if cfg is not None else "rascal-cli",
+        connect_timeout=timeout,
+        application_name="rascal-cli",
+    )
+    try:
+        if args.repair:
+            for line in repair_archive(cat, archive, args.context):
+                print("repaired: %s" % line, file=out)
+        problems = verify_archive(cat, archive, args.context)
+    finally:
+        cat.close()
+    for line in problems:
+        print(line, file=out)
+    what = "context %s" % args.context if args.context else "every context"
+    if problems:
+        print(
+            "archive %s, %s: %d problem%s (database %s)"
+            % (archive.root, what, len(problems), "" if len(problems) == 1 else "s", mask_dsn(dsn)),
+            file=out,
+        )
+        return exit_codes.INCOMPLETE
+    print(
+        "archive %s, %s: matches the catalogue (database %s)" % (archive.root, what, mask_dsn(dsn)),
+        file=out,
+    )
+    return exit_codes.COMPLETE
+
+
+def _add_verify(sub):
+    ver = sub.add_parser(
+        "verify", help="check the image archive against the catalogue (exit 1 on a problem)"
+    )
+    ver.add_argument("--context", help="only this context (default: every context)")
+    ver.add_argument(
+        "--repair",
+        action="store_true",
+        help="first rewrite stale or missing sidecars and remove old temporary files",
+    )
+    ver.add_argument("--archive", help="image archive root (default: archive.root of the config)")
+    ver.set_defaults(func=cmd_verify)
 
 
 def _add_run(sub):
@@ -266,7 +349,7 @@ def build_parser():
     p = argparse.ArgumentParser(prog="rascal", description="RASCAL: record pottery sherds.")
     p.add_argument("--config", help="site config (default: $RASCAL_CONFIG or config/rascal.yaml)")
     p.add_argument(
-        "--dsn", help="PostgreSQL DSN (default: $RASCAL_DSN, else database.dsn " "of the config)"
+        "--dsn", help="PostgreSQL DSN (default: $RASCAL_DSN, else database.dsn of the config)"
     )
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
@@ -274,22 +357,49 @@ def build_parser():
     _add_export(sub)
     _add_run(sub)
     _add_report(sub)
+    _add_verify(sub)
     return p
 
 
 def main(argv=None, out=None):
     out = out or sys.stdout
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(argv)  # bad arguments: usage and exit 2 (BAD_INPUT)
     try:
         return args.func(args, out)
     except UsageError as e:
         print("rascal: error: %s" % e, file=sys.stderr)
-        return 2
-    except Exception as e:  # one line for the operator; no traceback for expected failures
-        from rascal_tasks.catalogue.errors import CatalogueError
+        return exit_codes.BAD_INPUT
+    except KeyboardInterrupt:
+        print("rascal: interrupted", file=sys.stderr)
+        return exit_codes.INTERRUPTED
+    except Exception as e:  # one line for the operator, never a traceback
+        return _fault(e)
 
-        if isinstance(e, (CatalogueError, RuntimeError)):
-            print("rascal: error: %s" % e, file=sys.stderr)
-            return 1
-        raise
+
+def _fault(e: Exception) -> int:
+    """One line and the exit code for an exception out of a verb (RASCAL_DEBUG=1: re-raise)."""
+    from rascal_tasks.catalogue.errors import CatalogueError, FieldError
+
+    if os.environ.get("RASCAL_DEBUG"):
+        raise e
+    if isinstance(e, FieldError):  # a context ID or a value given by the user
+        print("rascal: error: %s" % e, file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    if isinstance(e, (CatalogueError, RuntimeError, OSError)):
+        print("rascal: error: %s" % e, file=sys.stderr)
+        return exit_codes.FAULT
+    try:
+        import psycopg2
+
+        if isinstance(e, psycopg2.Error):
+            first = (str(e).strip().splitlines() or [type(e).__name__])[0]
+            print("rascal: error: database: %s" % first, file=sys.stderr)
+            return exit_codes.FAULT
+    except ImportError:
+        pass
+    print(
+        "rascal: error: unexpected %s: %s (RASCAL_DEBUG=1 shows where)" % (type(e).__name__, e),
+        file=sys.stderr,
+    )
+    return exit_codes.FAULT

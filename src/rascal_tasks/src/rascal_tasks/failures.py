@@ -7,6 +7,10 @@ from rascal_tasks.rig import RigError
 # Arm codes that refuse a goal before the arm moves: the goal is wrong, not the rig
 # (rascal_control.results: UNREACHABLE, COLLISION, INVALID_GOAL; NO_IK for an IK that found none).
 ARM_REFUSALS = frozenset({"UNREACHABLE", "NO_IK", "COLLISION", "INVALID_GOAL"})
+# Codes that say the rig itself is not what the batch believes: the arm driver restarted (the
+# controller refuses goals until the next run acknowledges it), or the arm left its planned
+# path. Never about one sherd, even on a grasp target: park, stop, exit FAULT.
+UNSAFE = frozenset({"DRIVER_RESTARTED", "TRACKING_ERROR"})
 
 LOSE_SHERD = "lose_sherd"  # record this sherd lost with the reason, go on with the next one
 STOP = "stop"  # park the arm and end the batch 'aborted'; the sherd stays unfinished
@@ -28,6 +32,8 @@ def about_this_sherd(error: Exception, sherd_target: bool = False) -> bool:
     """Part 1 of the rule (see `classify`): whether `error` is about the sherd, not the rig."""
     if isinstance(error, SherdFailure):
         return True
+    if isinstance(error, RigError) and error.code in UNSAFE:
+        return False
     return isinstance(error, RigError) and sherd_target and error.code in ARM_REFUSALS
 
 
@@ -46,7 +52,8 @@ def classify(error: Exception, sherd_target: bool = False, left_in_the_way: bool
     A sherd is never in the fingers when LOSE_SHERD applies: every move made while it is held
     (travel, placing, lifting) stops the batch when refused.
 
-    STOP for everything else: TIMEOUT (an arm or scale that did not answer in time), PREEMPTED,
+    STOP for everything else: DRIVER_RESTARTED and TRACKING_ERROR (UNSAFE: the rig is not what
+    the batch believes), TIMEOUT (an arm or scale that did not answer in time), PREEMPTED,
     MISSING nodes, any gripper, perception, scale or camera error, any code not listed above,
     database errors, and any other exception. Anything raised by park ends the batch anyway.
     """

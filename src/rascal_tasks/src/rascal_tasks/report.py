@@ -72,6 +72,16 @@ def _breakdown_svg(rows) -> str:
     return "".join(out)
 
 
+def _note(r) -> str:
+    """Why a row is incomplete: lost, or weighed without a mass (mass_unstable)."""
+    parts = []
+    if r.get("mass_missing_reason"):
+        parts.append("no mass: %s" % r["mass_missing_reason"])
+    if r.get("lost_reason"):
+        parts.append(r["lost_reason"])
+    return "; ".join(parts)
+
+
 def write_report(context: str, rows, archive_root: str, summary: dict = None) -> str:
     """Write the report folder for `context`; returns the path of index.html."""
     folder = os.path.join(archive_root, context, "report")
@@ -97,7 +107,7 @@ def write_report(context: str, rows, archive_root: str, summary: dict = None) ->
                 _fmt(r.get("width_mm")),
                 _fmt(r.get("thickness_mm")),
                 _fmt(r.get("drops"), "%d"),
-                html.escape(r.get("lost_reason") or ""),
+                html.escape(_note(r)),
             )
         )
     lines = "".join(

@@ -26,6 +26,11 @@ class Home(BatchState):
 
     def run(self):
         b = self.batch
+        # A driver that restarted since the last run: this run calibrates anew, so the
+        # controller may take goals again.
+        acknowledged = b.rig.arm.acknowledge_restart()
+        if acknowledged.startswith("driver restart acknowledged"):
+            b.event(None, "driver_restart_acknowledged", acknowledged)
         rows = b.recorder.unfinished()
         if rows:
             with b.phase("grasping"):

@@ -44,8 +44,9 @@ class Observation:
 
 @dataclass
 class ScaleReading:
-    mass: float  # kg
-    stable: bool
+    mass: float  # kg, tared, as the scale shows it
+    stable: bool  # the scale's own stability flag (stations.ScaleStation does not trust it alone)
+    stamp: float = 0.0  # s (rig clock): when the reading was taken
 
 
 @dataclass
@@ -101,6 +102,13 @@ class Arm:
     def stop(self) -> None:
         raise NotImplementedError
 
+    def acknowledge_restart(self) -> str:
+        """Tell the arm controller this run knows its driver may have restarted and calibrates
+        anew: until then a controller that saw the driver restart refuses every goal
+        (DRIVER_RESTARTED). Called once when a run starts (HOME); returns the controller's line.
+        No-op by default (rigs without such a controller)."""
+        return ""
+
 
 class Gripper:
     def open(self, width: Optional[float] = None) -> float:
@@ -133,10 +141,14 @@ class Perception:
 
 class Scale:
     def tare(self) -> None:
+        """Zero the scale at its present load; readings taken after it returns are tared.
+        Raises RigError when the scale refuses or does not answer."""
         raise NotImplementedError
 
-    def read_stable(self, timeout: float) -> ScaleReading:
-        """The first stable reading, or the last reading (stable False) after `timeout`."""
+    def readings(self, since: float) -> List[ScaleReading]:
+        """The readings taken after `since` (rig clock, s), oldest first, of those kept (at
+        least the last 30 s); never waits. The weighing rule is the station's
+        (`stations.ScaleStation`), not the adapter's."""
         raise NotImplementedError
 
 

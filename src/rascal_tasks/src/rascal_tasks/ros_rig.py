@@ -2,9 +2,13 @@
 
 Arm and gripper go through rascal_control's Python client (the `/rascal/arm/move` and
 `/rascal/gripper` actions); perception, scale and archival camera through their services and
-topics. Every wait is sliced and gives up with a RigError naming the topic or service.
+topics. Every wait has a deadline derived from the configuration's timings (rascal_control's
+`deadline.py`: ROS and wall time, wall time alone while ROS time stands still), gives up with a
+RigError naming the node, topic or service, and ends within 0.05 s when the run's `stop` event
+is set during it (Ctrl-C), with code PREEMPTED.
 """
 
+import collections
 import math
 import threading
 import time
@@ -12,6 +16,7 @@ import time
 import rospy
 from rascal_control import Arm as ControlArm
 from rascal_control import Gripper as ControlGripper
+from rascal_control import deadline as dl
 from rascal_control.results import ControlError, Timeout
 from std_srvs.srv import Trigger
 
@@ -25,7 +30,17 @@ SERVICE_WAIT = 30.0  # s (wall clock): how long a node may take to come up
 # holding rule, the same its close result uses) with every /joint_states message.
 GRIPPER_STATE = "/rascal/gripper/state"
 GRIPPER_STATE_WAIT = 2.0  # s (wall clock) without a fresh gripper state: the controller is silent
-CODE_NAMES = {1: "UNREACHABLE", 2: "COLLISION", 3: "TIMEOUT", 4: "PREEMPTED", 5: "INVALID_GOAL"}
+CODE_NAMES = {
+    1: "UNREACHABLE",
+    2: "COLLISION",
+    3: "TIMEOUT",
+    4: "PREEMPTED",
+    5: "INVALID_GOAL",
+    6: "DRIVER_RESTARTED",
+    7: "TRACKING_ERROR",
+}
+TF_WAIT = 0.5  # [s] the detector's TF lookup after its frame (rascal_perception's README)
+CLOCK_STALL = 2.0  # [s] wall time without ROS time moving: the clock (simulator) is gone
 
 
 def _yaw(q) -> float:
@@ -71,12 +86,84 @@ def _rig_error(device: str, e: ControlError) -> rig.RigError:
     return rig.RigError(device, CODE_NAMES.get(e.code, "FAILED"), e.message)
 
 
-class RosArm(rig.Arm):
-    """rascal_control.Arm with the gripper pointing down."""
+_CONFIG = []  # the parameter server's checked configuration, read once
 
-    def __init__(self, speed_scale: float = 1.0):
+
+def _config(config):
+    """`config`, or the parameter server's checked configuration (what the nodes read)."""
+    if config is not None:
+        return config
+    if not _CONFIG:
+        from rascal_tasks.config import ConfigError
+        from rascal_tasks.ros_config import load_from_param_server
+
         try:
-            self._arm = ControlArm(wait=SERVICE_WAIT)
+            _CONFIG.append(load_from_param_server())
+        except ConfigError as e:
+            raise rig.RigError("config", "INVALID", str(e)) from None
+    return _CONFIG[0]
+
+
+def _call(fn, *args, seconds, stop, device, code, node, name):
+    """A service call with a deadline of `seconds` (ROS and wall time) that `stop` interrupts;
+    RigError(device, TIMEOUT | PREEMPTED | code) naming `node` and the service `name`."""
+    try:
+        return dl.call(fn, *args, deadline=dl.Deadline(seconds, dl.ros_time), stop=stop)
+    except dl.Unfinished as e:
+        if e.outcome == dl.STOPPED:
+            raise rig.RigError(device, "PREEMPTED", "stop requested") from None
+        raise rig.RigError(
+            device,
+            "TIMEOUT",
+            "%s not answering on %s within %.1f s; is it running?" % (node, name, seconds),
+        ) from None
+    except rospy.ServiceException as e:
+        first = (str(e).splitlines() or [type(e).__name__])[0]
+        raise rig.RigError(
+            device, code, "%s not answering on %s (%s); is it running?" % (node, name, first)
+        ) from None
+
+
+def ros_sleep(seconds: float, stop=None):
+    """Sleep `seconds` of ROS time. RigError when ROS time runs backwards (the simulator or the
+    driver restarted), stands still for CLOCK_STALL seconds of wall time (no /clock), or `stop`
+    is set during the sleep."""
+    watch_stop = stop is not None and not stop.is_set()
+    start = last = rospy.get_time()
+    moved = time.monotonic()
+    while True:
+        now = rospy.get_time()
+        if now - start >= seconds:
+            return
+        if now < last:
+            raise rig.RigError(
+                "/clock",
+                "DRIVER_RESTARTED",
+                "ROS time went backwards (%.3f s -> %.3f s): the simulator (arm driver) "
+                "restarted; re-run `rascal run` to re-calibrate" % (last, now),
+            )
+        if now != last:
+            last, moved = now, time.monotonic()
+        elif time.monotonic() - moved > CLOCK_STALL:
+            raise rig.RigError(
+                "/clock",
+                "TIMEOUT",
+                "ROS time stood still for %.0f s (no /clock); is the simulator (or the "
+                "driver) running?" % CLOCK_STALL,
+            )
+        if watch_stop and stop.is_set():
+            raise rig.RigError("batch", "PREEMPTED", "stop requested")
+        time.sleep(0.005)
+
+
+class RosArm(rig.Arm):
+    """rascal_control.Arm with the gripper pointing down. `config`: the checked configuration
+    (default: the parameter server's), for the deadlines; `stop`: the run's stop event."""
+
+    def __init__(self, speed_scale: float = 1.0, config=None, stop=None):
+        timings = dl.ControllerTimings.from_config(_config(config))
+        try:
+            self._arm = ControlArm(wait=SERVICE_WAIT, timings=timings, stop=stop)
         except ControlError as e:
             raise _rig_error("/rascal/arm/move", e) from None
         self.speed_scale = speed_scale
@@ -89,9 +176,10 @@ class RosArm(rig.Arm):
                     pose, motion="linear" if linear else "joint", speed_scale=self.speed_scale
                 ).duration
             except Timeout as e:
-                # The arm did not arrive (a stalled or lost trajectory): send the goal once more
-                # from where it is; a second timeout is a fault for a person to look at.
-                if attempt:
+                # The controller says the arm did not arrive (a stalled or lost trajectory): send
+                # the goal once more from where it is; a second timeout is a fault for a person
+                # to look at. A controller that did not answer at all (no result) is one now.
+                if attempt or e.result is None:
                     raise _rig_error("arm", e) from None
                 rospy.logwarn("arm: %s; trying the move once more", e.message)
             except ControlError as e:
@@ -106,15 +194,23 @@ class RosArm(rig.Arm):
     def stop(self):
         self._arm.stop()
 
+    def acknowledge_restart(self):
+        try:
+            return self._arm.acknowledge_restart()
+        except ControlError as e:
+            raise _rig_error("arm", e) from None
+
 
 class RosGripper(rig.Gripper):
     """rascal_control.Gripper, plus the controller's gripper state (GRIPPER_STATE) to notice a
     drop: whether a sherd is held is the controller's decision, not a threshold applied here."""
 
-    def __init__(self, held_margin=None):
+    def __init__(self, held_margin=None, config=None, stop=None):
         del held_margin  # unused: the controller applies arm.gripper.held_margin (kept for callers)
+        timings = dl.ControllerTimings.from_config(_config(config))
+        self._stop = stop
         try:
-            self._gripper = ControlGripper(wait=SERVICE_WAIT)
+            self._gripper = ControlGripper(wait=SERVICE_WAIT, timings=timings, stop=stop)
         except ControlError as e:
             raise _rig_error("/rascal/gripper", e) from None
         self._state = None  # the latest rascal_msgs/GripperState
@@ -134,12 +230,23 @@ class RosGripper(rig.Gripper):
 
     def _fresh_state(self):
         """The first gripper state stamped after the last command ended; RigError when none comes
-        within GRIPPER_STATE_WAIT seconds of wall time."""
+        within GRIPPER_STATE_WAIT seconds of wall time, when ROS time went back before the last
+        command (a restarted simulator: its states are stamped earlier), or on `stop`."""
         deadline = time.monotonic() + GRIPPER_STATE_WAIT
+        watch_stop = self._stop is not None and not self._stop.is_set()
         while not rospy.is_shutdown():
             state = self._state
             if state is not None and state.header.stamp >= self._after:
                 return state
+            if rospy.Time.now() < self._after:
+                raise rig.RigError(
+                    GRIPPER_STATE,
+                    "DRIVER_RESTARTED",
+                    "ROS time went back before the last gripper command: the simulator (arm "
+                    "driver) restarted; re-run `rascal run` to re-calibrate",
+                )
+            if watch_stop and self._stop.is_set():
+                raise rig.RigError("gripper", "PREEMPTED", "stop requested")
             if time.monotonic() > deadline:
                 break
             time.sleep(0.005)
@@ -170,18 +277,31 @@ class RosPerception(rig.Perception):
     ATTEMPTS = 4
     RETRY_WAIT = 0.3  # s (ROS time)
 
-    def __init__(self):
+    def __init__(self, config=None, stop=None):
+        cfg = _config(config)
+        # each call: the detector's frame wait and TF lookup, and the margin
+        self.timeout = cfg["perception"]["frame_wait"] + TF_WAIT + cfg["rig"]["answer_margin"]
+        self._stop = stop
         self._detect = _proxy("/rascal/perception/detect", Detect)
         self._calibrate = _proxy("/rascal/perception/calibrate_background", CalibrateBackground)
 
-    def _call(self, proxy, station, what):
+    def _call(self, proxy, station, what, none_if=None):
+        """The successful response; None as soon as a failure's message holds `none_if`."""
         for attempt in range(self.ATTEMPTS):
-            try:
-                res = proxy(station)
-            except rospy.ServiceException as e:
-                raise rig.RigError("perception", what, str(e)) from None
+            res = _call(
+                proxy,
+                station,
+                seconds=self.timeout,
+                stop=self._stop,
+                device="perception",
+                code=what,
+                node="sherd_detector",
+                name=proxy.resolved_name,
+            )
             if res.success:
                 return res
+            if none_if and none_if in res.message:
+                return None
             rospy.logwarn(
                 "perception %s at %s failed (attempt %d): %s",
                 what.lower(),
@@ -189,7 +309,7 @@ class RosPerception(rig.Perception):
                 attempt + 1,
                 res.message,
             )
-            rospy.sleep(self.RETRY_WAIT)
+            ros_sleep(self.RETRY_WAIT, self._stop)
         raise rig.RigError("perception", what, res.message)
 
     def calibrate(self, station):
@@ -200,83 +320,95 @@ class RosPerception(rig.Perception):
         return [observation_from_msg(s) for s in res.detections.sherds]
 
     def detect_if_calibrated(self, station):
-        """Detections, or None when the station has no background model yet. Any attempt may be
-        the one that says so: one that failed first on a frame or transform still on its way (at
-        start-up with the simulator at full speed) says it on the retry."""
-        for attempt in range(self.ATTEMPTS):
-            try:
-                res = self._detect(station)
-            except rospy.ServiceException as e:
-                raise rig.RigError("perception", "DETECT", str(e)) from None
-            if res.success:
-                return [observation_from_msg(s) for s in res.detections.sherds]
-            if "no background model" in res.message:
-                return None
-            rospy.logwarn(
-                "perception detect at %s failed (attempt %d): %s", station, attempt + 1, res.message
-            )
-            rospy.sleep(self.RETRY_WAIT)
-        raise rig.RigError("perception", "DETECT", res.message)
+        # Any attempt may be the one that says 'no background model': the detector waits for a
+        # frame and its transform before it looks for the model, so an attempt that failed on
+        # those (at start-up with the simulator at full speed, TF lags the images) says it on
+        # the retry. (Retrying through detect() turned that answer into an error.)
+        res = self._call(self._detect, station, "DETECT", none_if="no background model")
+        return None if res is None else [observation_from_msg(s) for s in res.detections.sherds]
 
 
 class RosScale(rig.Scale):
-    """/scale/mass readings; a stable reading counts only if taken after the request."""
+    """/scale/mass readings, kept with their stamps (the last KEEP); /scale/tare answered within
+    rig.answer_margin. How long and how steady a reading must be is the station's rule
+    (`stations.ScaleStation`), not this adapter's."""
 
-    def __init__(self, clock):
-        self.clock = clock
-        self._lock = threading.Condition()
-        self._last = None
+    KEEP = 600  # readings: a minute at the scale's 10 Hz
+
+    def __init__(self, clock=None, config=None, stop=None):
+        self.clock = clock  # unused: readings carry their own stamps (kept for callers)
+        self._timeout = _config(config)["rig"]["answer_margin"]
+        self._stop = stop
+        self._lock = threading.Lock()
+        self._kept = collections.deque(maxlen=self.KEEP)
         self._sub = rospy.Subscriber("/scale/mass", ScaleReadingMsg, self._on_reading, queue_size=5)
         self._tare = _proxy("/scale/tare", Trigger)
 
+    @staticmethod
+    def reading_from_msg(msg, received: float) -> rig.ScaleReading:
+        """rascal_msgs/ScaleReading -> ScaleReading; an unstamped reading takes `received`."""
+        stamp = msg.header.stamp.to_sec() or received
+        return rig.ScaleReading(msg.mass, bool(msg.stable), stamp)
+
     def _on_reading(self, msg):
+        r = self.reading_from_msg(msg, rospy.get_time())
         with self._lock:
-            self._last = msg
-            self._lock.notify_all()
+            if self._kept and r.stamp < self._kept[-1].stamp:
+                self._kept.clear()  # time ran backwards: the simulator or the driver restarted
+            self._kept.append(r)
 
     def tare(self):
-        res = self._tare()
+        res = _call(
+            self._tare,
+            seconds=self._timeout,
+            stop=self._stop,
+            device="/scale/tare",
+            code="TARE",
+            node="the scale (its driver, or the simulator)",
+            name="/scale/tare",
+        )
         if not res.success:
             raise rig.RigError("/scale/tare", "TARE", res.message)
 
-    def read_stable(self, timeout):
-        start = rospy.Time.now()
-        deadline = self.clock.now() + timeout
-        last = None
-        while self.clock.now() < deadline and not rospy.is_shutdown():
-            with self._lock:
-                self._lock.wait(0.05)
-                msg = self._last
-            if msg is None or msg.header.stamp <= start:
-                continue
-            last = msg
-            if msg.stable:
-                return rig.ScaleReading(msg.mass, True)
-        if last is None:
-            raise rig.RigError("/scale/mass", "TIMEOUT", "no reading within %.1f s" % timeout)
-        return rig.ScaleReading(last.mass, False)
+    def readings(self, since):
+        with self._lock:
+            return [r for r in self._kept if r.stamp > since]
 
 
 class RosArchivalCamera(rig.ArchivalCamera):
-    def __init__(self):
+    """/archival_camera/capture, answered within rig.capture_timeout."""
+
+    def __init__(self, config=None, stop=None):
+        self.timeout = _config(config)["rig"]["capture_timeout"]
+        self._stop = stop
         self._capture = _proxy("/archival_camera/capture", CaptureArchival)
 
     def capture(self, path):
-        try:
-            res = self._capture(path)
-        except rospy.ServiceException as e:
-            raise rig.RigError("/archival_camera/capture", "FAILED", str(e)) from None
+        res = _call(
+            self._capture,
+            path,
+            seconds=self.timeout,
+            stop=self._stop,
+            device="/archival_camera/capture",
+            code="FAILED",
+            node="the archival camera (its driver, or the simulator)",
+            name="/archival_camera/capture",
+        )
         if not res.success:
             raise rig.RigError("/archival_camera/capture", "REFUSED", res.message)
         return rig.Capture(res.path, res.stamp.to_sec(), res.width, res.height)
 
 
 class RosClock(rig.Clock):
-    """ROS time: simulated time under use_sim_time."""
+    """ROS time: simulated time under use_sim_time. Sleeps end with a RigError when the clock
+    stops or runs backwards, or on `stop` (see ros_sleep)."""
+
+    def __init__(self, stop=None):
+        self._stop = stop
 
     def now(self):
         return rospy.get_time()
 
     def sleep(self, seconds):
         if seconds > 0:
-            rospy.sleep(seconds)
+            ros_sleep(seconds, self._stop)

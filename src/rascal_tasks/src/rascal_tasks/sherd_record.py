@@ -3,8 +3,9 @@ for it.
 
 A sherd is numbered once it is in the gripper (`SherdRecord.picked`), or taken over from a killed
 run (`SherdRecord.resumed`). Its status then moves picked -> weighed -> photographed -> done, or
-to lost. `done` and `lost` both end in `_finish`, the one place that counts completed and lost
-sherds. No ROS here.
+to lost; `mass_unstable` stands for weighed when the scale gave no trustworthy mass (no mass is
+recorded, the row says why). `done` and `lost` both end in `_finish`, the one place that counts
+completed and lost sherds. No ROS here.
 """
 
 from typing import Optional, Tuple
@@ -71,9 +72,20 @@ class SherdRecord:
     def record_dimensions(self, o: Observation):
         self.batch.recorder.dimensions(self.seq, o.length, o.width, o.height)
 
-    def record_mass(self, kg: float, stable: bool):
-        self.batch.recorder.mass(self.seq, kg, stable)
+    def record_mass(self, kg: float, stable: bool = True):
+        """A settled mass (stations.ScaleStation's rule); an unstable one is never recorded."""
+        if not stable:
+            raise ValueError(
+                "SherdRecord.record_mass: sherd %d: an unstable reading is not a mass; "
+                "use record_mass_unstable" % self.seq
+            )
+        self.batch.recorder.mass(self.seq, kg, True)
         self.mass, self.status = kg, "weighed"
+
+    def record_mass_unstable(self, reason: str):
+        """The scale gave no trustworthy mass: the row says why and has no mass."""
+        self.batch.recorder.mass_unstable(self.seq, reason)
+        self.mass, self.status = None, "mass_unstable"
 
     def spool_path(self) -> str:
         return self.batch.recorder.spool_path(self.seq)

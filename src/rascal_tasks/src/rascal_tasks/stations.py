@@ -8,14 +8,17 @@ No ROS here: plug-ins use the rig interfaces (`rig.py`) and write through the sh
 """
 
 import math
-from typing import Dict, Type
+from typing import Dict, List, Optional, Tuple, Type
 
-from rascal_tasks.rig import RigError
+from rascal_tasks.rig import RigError, ScaleReading
 
 STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
 # The smallest sherd worth recording: 2 x 2 cm, 4 mm wall at 1.8 g/cm^3 is about 2.9 g
-# (shared/facts/sherds_and_colour.md §2). A lighter reading means the sherd is not on the scale.
+# (shared/facts/sherds_and_colour.md §2). A lighter steady reading means the sherd is not on the
+# scale; an unsteady one means nothing.
 MIN_SHERD_MASS = 0.001  # kg
+SCALE_POLL = 0.05  # s (rig clock) between looks at the scale's readings
+_STAMP_SLACK = 1e-3  # s: readings 10 Hz apart stamped a little early or late still cover
 
 
 def station_type(name: str):
@@ -59,37 +62,153 @@ class StationPlugin:
         raise NotImplementedError
 
 
+def settled(readings: List[ScaleReading], window: float, readability: float):
+    """The weighing rule, on `readings` (oldest first): the last `window` seconds as one reading
+    (their mean, stamped with the last one), or None unless readings cover that whole window
+    (one is at or before its start), every one of them lies within `readability` of every
+    other, and the scale itself calls the last one stable."""
+    if not readings or not readings[-1].stable:
+        return None
+    last = readings[-1]
+    start = last.stamp - window + _STAMP_SLACK
+    first = max((i for i, r in enumerate(readings) if r.stamp <= start), default=None)
+    if first is None:
+        return None  # not watched for a whole window yet
+    masses = [r.mass for r in readings[first:]]
+    if max(masses) - min(masses) > readability + 1e-9:
+        return None
+    return ScaleReading(round(sum(masses) / len(masses), 7), True, last.stamp)
+
+
 @station_type("scale")
 class ScaleStation(StationPlugin):
-    status = "weighed"
+    """Weighs the sherd. A mass is recorded only when the reading held within the scale's
+    readability for `scale.stable_window` seconds (`settled`) on a platform tared after it had
+    settled empty, the tare checked (the empty platform then reads 0 within the readability).
+    An unsettled tare is done again, and an unsettled reading is read again, `scale.rereads`
+    times; then the sherd is recorded `mass_unstable`, without a mass, and goes on to the next
+    station. Only a settled reading below MIN_SHERD_MASS means the sherd is not there."""
+
+    status = "weighed"  # or mass_unstable: weighed, but no trustworthy mass
     hover_after_place = True
 
+    def __init__(self, station, batch):
+        super().__init__(station, batch)
+        self._tared_for = None  # seq of the sherd the scale was tared (and checked) for
+
+    def _cfg(self):
+        return self.batch.config["scale"]
+
+    def _settle(self, since: float) -> Tuple[Optional[ScaleReading], Optional[ScaleReading]]:
+        """Waits up to scale.stable_timeout for the readings taken after `since` to settle;
+        returns (the settled reading or None, the last reading). RigError when the scale sends
+        nothing at all."""
+        b, cfg = self.batch, self._cfg()
+        clock = b.rig.clock
+        deadline = clock.now() + cfg["stable_timeout"]
+        last = None
+        while True:
+            b.check_stop()
+            readings = b.rig.scale.readings(since)
+            if readings:
+                last = readings[-1]
+                reading = settled(readings, cfg["stable_window"], cfg["readability"])
+                if reading is not None:
+                    return reading, last
+            if clock.now() >= deadline:
+                break
+            clock.sleep(SCALE_POLL)
+        if last is None:
+            raise RigError(
+                "/scale/mass",
+                "TIMEOUT",
+                "no scale reading for %.1f s; is the scale (its driver, or the simulator) "
+                "running?" % cfg["stable_timeout"],
+            )
+        return None, last
+
+    def _unsteady(self, last) -> str:
+        cfg = self._cfg()
+        return "not within %.1f g for %.1f s in %.1f s (last reading %.1f g)" % (
+            cfg["readability"] * 1000,
+            cfg["stable_window"],
+            cfg["stable_timeout"],
+            last.mass * 1000,
+        )
+
+    def _tare_once(self) -> Optional[str]:
+        """Tare after a settled empty reading, then check it; None when it took, else why not."""
+        b, cfg = self.batch, self._cfg()
+        now = b.rig.clock.now()
+        empty, last = self._settle(now - cfg["stable_window"] - 1.0)  # what it read till now too
+        if empty is None:
+            return "empty platform %s" % self._unsteady(last)
+        b.rig.scale.tare()
+        zero, last = self._settle(b.rig.clock.now())
+        if zero is None:
+            return "after the tare %s" % self._unsteady(last)
+        if abs(zero.mass) > cfg["readability"] + 1e-9:
+            return "the empty platform reads %.1f g after the tare" % (zero.mass * 1000)
+        return None
+
     def before_place(self, sherd):
-        with self.batch.phase("data_collection"):
-            self.batch.rig.scale.tare()
+        self._tared_for = None
+        b = self.batch
+        with b.phase("data_collection"):
+            for attempt in range(1 + self._cfg()["rereads"]):
+                problem = self._tare_once()
+                if problem is None:
+                    self._tared_for = sherd.seq
+                    return
+                b.event(sherd, "tare_failed", "attempt %d: %s" % (attempt + 1, problem))
+        # Recorded before placing: a restart that finds it lying on the scale does not weigh it.
+        self._mass_unstable(sherd, "the scale could not be tared (%s)" % problem)
 
     def after_place(self, sherd):
-        cfg = self.batch.config["scale"]
-        reading = None
-        with self.batch.phase("data_collection"):
+        b, cfg = self.batch, self._cfg()
+        if self._tared_for != sherd.seq:
+            if sherd.status == "mass_unstable":
+                return "done"  # the tare failed (recorded), or so recorded before a restart
+            # after a restart, found lying on the scale: the run before tared and checked it
+            b.event(sherd, "tare_unchecked", "lying on the scale after a restart")
+        reading = last = None
+        since = b.rig.clock.now()
+        with b.phase("data_collection"):
             for attempt in range(1 + cfg["rereads"]):
-                reading = self.batch.rig.scale.read_stable(cfg["stable_timeout"])
-                if reading.stable:
+                reading, last = self._settle(since)
+                if reading is not None:
                     break
-                self.batch.event(
-                    sherd,
-                    "scale_unstable",
-                    "attempt %d: %.1f g" % (attempt + 1, reading.mass * 1000),
+                b.event(
+                    sherd, "scale_unstable", "attempt %d: %s" % (attempt + 1, self._unsteady(last))
                 )
+        if reading is None:
+            self._mass_unstable(
+                sherd,
+                "the reading did not hold within %.1f g for %.1f s in %d attempts of %.1f s"
+                % (
+                    cfg["readability"] * 1000,
+                    cfg["stable_window"],
+                    1 + cfg["rereads"],
+                    cfg["stable_timeout"],
+                ),
+            )
+            return "done"
         if reading.mass < MIN_SHERD_MASS:
-            # Nothing on the pan: the sherd slipped away unnoticed on the way; look for it.
-            self.batch.event(
-                sherd, "scale_empty", "reads %.1f g after placing the sherd" % (reading.mass * 1000)
+            # A steady empty pan: the sherd slipped away unnoticed on the way; look for it.
+            b.event(
+                sherd, "scale_empty", "reads %.1f g, steady, after placing" % (reading.mass * 1000)
             )
             return "missing"
-        # An unstable last reading is still recorded, and flagged in the sherd's notes.
-        sherd.record_mass(reading.mass, reading.stable)
+        sherd.record_mass(reading.mass)
         return "done"
+
+    def _mass_unstable(self, sherd, reason: str):
+        """No trustworthy mass: recorded so (no mass value), and the sherd goes on."""
+        self.batch.log("sherd %d mass_unstable: %s" % (sherd.seq, reason))
+        if sherd.status == "weighed":  # a mass taken before stands (a re-weigh that failed)
+            sherd.note("mass_unstable: %s; the mass recorded before stands" % reason)
+        else:
+            sherd.record_mass_unstable(reason)
 
 
 @station_type("archival_camera")

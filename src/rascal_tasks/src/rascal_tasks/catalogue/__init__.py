@@ -6,11 +6,20 @@ No ROS here: the connection, logger and clock are passed in.
 """
 
 from .archive import ImageArchive
-from .catalogue import SOFTWARE_VERSION, Catalogue
+from .catalogue import SOFTWARE_VERSION, Catalogue, wait_for_database
 from .context_id import MAX_ID_LENGTH, validate_context_id, validate_site_id
-from .errors import CatalogueError, ContextIdError, FieldError, MigrationError, StatusError
+from .errors import (
+    ArchiveError,
+    CatalogueError,
+    ConnectionLostError,
+    ContextIdError,
+    FieldError,
+    MigrationError,
+    StatusError,
+)
 from .export import export_records, parse_csv, to_csv, to_json
 from .fields import COLUMN_TYPES, COLUMNS
+from .integrity import repair_archive, verify_archive
 from .migrate import available, migrate, status
 
 __all__ = [
@@ -25,6 +34,11 @@ __all__ = [
     "FieldError",
     "MigrationError",
     "StatusError",
+    "ConnectionLostError",
+    "ArchiveError",
+    "wait_for_database",
+    "repair_archive",
+    "verify_archive",
     "export_records",
     "parse_csv",
     "to_csv",

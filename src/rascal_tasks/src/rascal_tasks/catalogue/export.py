@@ -23,7 +23,8 @@ EXPORT_VERSION = 1
 
 _SELECT = (
     "SELECT s.context_id || '-' || s.seq AS find_id, c.site_id, s.context_id, s.seq, "
-    "s.status::text AS status, mass_g, length_mm, width_mm, thickness_mm, colour_munsell, "
+    "s.status::text AS status, mass_g, mass_missing_reason, length_mm, width_mm, thickness_mm, "
+    "colour_munsell, "
     "colour_l, colour_a, colour_b, chart_delta_e00, px_per_cm, image_path, image_sha256, drops, "
     "grasp_attempts, pickup_x_m, pickup_y_m, t_pick_s, t_weigh_s, t_photo_s, t_discard_s, "
     "t_locomotion_s, t_grasping_s, t_data_collection_s, t_perception_s, "

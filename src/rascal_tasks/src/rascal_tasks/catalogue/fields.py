@@ -22,7 +22,7 @@ __all__ = [
     "check_munsell",
 ]
 
-STATUSES = ("picked", "weighed", "photographed", "done", "lost")
+STATUSES = ("picked", "mass_unstable", "weighed", "photographed", "done", "lost")
 # the paper's breakdown of the time per sherd (columns t_<phase>_s)
 PHASES = ("locomotion", "grasping", "data_collection", "perception")
 
@@ -32,8 +32,9 @@ COLUMNS = [
     ("site_id", "text", "excavation site code"),
     ("context_id", "text", "context (stratigraphic unit / bag) the sherd came from"),
     ("seq", "int", "sequence number within the context, gap-free from 1"),
-    ("status", "text", "picked | weighed | photographed | done | lost"),
-    ("mass_g", "float", "mass [g]"),
+    ("status", "text", "picked | mass_unstable | weighed | photographed | done | lost"),
+    ("mass_g", "float", "mass [g]; empty when the scale gave none to trust (mass_missing_reason)"),
+    ("mass_missing_reason", "text", "why there is no mass (the scale did not settle or tare)"),
     ("length_mm", "float", "maximum length [mm]"),
     ("width_mm", "float", "maximum width across the length [mm]"),
     ("thickness_mm", "float", "wall thickness [mm]"),
@@ -63,7 +64,7 @@ COLUMNS = [
     ("software_version", "text", "recording software"),
     ("config_hash", "text", "hash of the site configuration in use"),
     ("picked_at", "timestamp", "when it was picked up (ISO 8601, UTC)"),
-    ("weighed_at", "timestamp", "when its mass was recorded"),
+    ("weighed_at", "timestamp", "when its mass was recorded (or found untrustworthy)"),
     ("photographed_at", "timestamp", "when its image was archived"),
     ("done_at", "timestamp", "when it was discarded and its record completed"),
     ("lost_at", "timestamp", "when it was recorded as lost"),
