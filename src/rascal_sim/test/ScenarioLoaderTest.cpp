@@ -97,6 +97,22 @@ TEST(ScenarioLoader, ErrorsNameTheKey) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("lighting.brightness"), std::string::npos) << e.what();
   }
+  try {
+    loader.parse("lighting: {realism: {cast_shadow: 0.95}}\n");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("lighting.realism.cast_shadow"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ScenarioLoader, RealismIsOffUnlessAskedForAndAKeyLeftOutTakesItsDefault) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  EXPECT_FALSE(loader.parse("lighting: {brightness: 1.0}\n").lighting.realism.any());
+  const Realism r = loader.parse("lighting: {realism: {glare: 0.2}}\n").lighting.realism;
+  EXPECT_DOUBLE_EQ(r.glare, 0.2);
+  EXPECT_DOUBLE_EQ(r.texture, 1.0);
+  EXPECT_DOUBLE_EQ(r.cast_shadow, 0.5);
 }
 
 TEST(ScenarioLoader, ShippedScenariosLoad) {
@@ -109,6 +125,9 @@ TEST(ScenarioLoader, ShippedScenariosLoad) {
   ASSERT_EQ(small.sherds.size(), 3u);
   EXPECT_FALSE(small.sherds[2].mesh_file.empty());
   for (const auto& s : demo.sherds) EXPECT_NO_THROW(SherdMeshBuilder::build(s)) << s.name;
+  const Scenario field = loader.load(dir + "field_10.yaml");
+  EXPECT_EQ(field.sherds.size(), 10u);
+  EXPECT_TRUE(field.lighting.realism.any());
 }
 
 TEST(ScenarioLoader, TouchingPairsMeet) {

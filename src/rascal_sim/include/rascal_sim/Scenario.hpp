@@ -23,6 +23,17 @@ struct SherdSpec {
   double drop_height = 0.0;              ///< [m] gap under the sherd when spawned
 };
 
+/// What makes a wrist frame look like a field photo (all 0 = the plain rendering). Wrist camera
+/// only: the archival camera keeps the sherd's colour as its Munsell chip gives it.
+struct Realism {
+  double texture = 0.0;      ///< [1] 0 .. 1: cloth and sherd surface textures sampled from real photos
+  double cast_shadow = 0.0;  ///< [1] 0 .. 0.8: fraction of light a sherd's cast shadow takes from the cloth
+  double glare = 0.0;        ///< [1] 0 .. 1: specular highlights on the sherds (glaze, slip)
+  double light_azimuth = 2.4;     ///< [rad] direction the light comes from, about +z in base_link
+  double light_elevation = 0.8;   ///< [rad] above the table
+  bool any() const { return texture > 0.0 || cast_shadow > 0.0 || glare > 0.0; }
+};
+
 struct Lighting {
   double brightness = 1.0;            ///< [1] 0.3 .. 1.5
   double colour_temperature = 6500;   ///< [K] 2500 .. 10000; 6500 = neutral
@@ -31,6 +42,7 @@ struct Lighting {
   Eigen::Vector2d shadow_start{0.0, 0.4};     ///< [m] shadow centre on the table at t = 0
   Eigen::Vector2d shadow_velocity{0.0, -0.01};  ///< [m/s] it drifts across the table
   double colour_noise = 2.0;          ///< [8-bit counts] sigma of the colour sensor noise
+  Realism realism;
 };
 
 struct Scenario {

@@ -12,6 +12,7 @@
 #include "rascal_sim/ScaleSensor.hpp"
 #include "rascal_sim/Scenario.hpp"
 #include "rascal_sim/SensorEffects.hpp"
+#include "rascal_sim/SurfaceRealism.hpp"
 #include "rascal_sim/ServoModel.hpp"
 #include "rascal_sim/World.hpp"
 #include "rascal_workcell/GripperGeometry.hpp"
@@ -121,6 +122,7 @@ class Simulator {
   ArchivalCamera archival_;
   Renderer renderer_;
   SensorEffects effects_;
+  SurfaceRealism realism_;  ///< loaded with the first scenario that asks for it
   Scenario scenario_;
   std::mt19937 rng_;
   double next_wrist_frame_ = 0.0;

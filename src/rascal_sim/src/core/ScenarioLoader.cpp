@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -85,6 +86,16 @@ Scenario ScenarioLoader::parse(const std::string& yaml_text) const {
     l.brightness = number(light["brightness"], "lighting.brightness", 1.0, 0.3, 1.5);
     l.colour_temperature = number(light["colour_temperature"], "lighting.colour_temperature", 6500, 2500, 10000);
     l.colour_noise = number(light["colour_noise"], "lighting.colour_noise", 2.0, 0.0, 20.0);
+    const YAML::Node re = light["realism"];
+    if (re) {
+      Realism& r = l.realism;
+      r.texture = number(re["texture"], "lighting.realism.texture", 1.0, 0.0, 1.0);
+      r.cast_shadow = number(re["cast_shadow"], "lighting.realism.cast_shadow", 0.5, 0.0, 0.8);
+      r.glare = number(re["glare"], "lighting.realism.glare", 0.5, 0.0, 1.0);
+      r.light_azimuth = number(re["light_azimuth"], "lighting.realism.light_azimuth", r.light_azimuth, -M_PI, M_PI);
+      r.light_elevation =
+          number(re["light_elevation"], "lighting.realism.light_elevation", r.light_elevation, 0.3, M_PI / 2);
+    }
     const YAML::Node sh = light["shadow"];
     if (sh) {
       l.shadow_strength = number(sh["strength"], "lighting.shadow.strength", 0.4, 0.0, 0.8);

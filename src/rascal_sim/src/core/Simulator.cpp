@@ -42,6 +42,7 @@ Simulator::Simulator(const WorldLayout& layout, const SimulatorOptions& options)
 }
 
 void Simulator::load(const Scenario& scenario) {
+  if (scenario.lighting.realism.any() && !realism_.loaded()) realism_.load(layout_.data_dir);
   world_.spawn(scenario.sherds);
   world_.seedSolver(scenario.seed);
   scenario_ = scenario;
@@ -210,6 +211,7 @@ WristFrame Simulator::renderWristFrame() {
     f.blurred = true;
     blur = std::max(3.0, speed * cam.fx * kExposure);
   }
+  realism_.apply(scratch_.colour, scratch_, cam, f.world_T_camera, scenario_.lighting.realism);
   effects_.colourImage(scratch_.colour, scratch_.depth, cam, f.world_T_camera, scenario_.lighting, f.stamp, blur);
   f.rgb = scratch_.colour.clone();
   f.depth_mm = effects_.depthImage(scratch_.depth, cam);
