@@ -315,3 +315,18 @@ def test_a_sherd_seen_off_the_station_is_left_for_a_person(data):
     assert Recover(batch).run() == "lost"
     notes = [c[2] for c in batch.recorder.calls if c[0] == "note"]
     assert any("off the scale" in n and "(0.320, -0.120)" in n for n in notes), notes
+
+
+def test_the_batch_keeps_why_it_stopped_and_whether_the_arm_was_parked(data):
+    class _StuckArm(rig.Arm):
+        def go(self, named):
+            raise rig.RigError("arm", "TIMEOUT", "no answer from /rascal/arm/move after 12 s")
+
+    b = _batch(config_from_dict(data))
+    b.event(None, "rig_error", "arm: TIMEOUT: no answer")
+    assert (b.stop_reason, b.park_failed) == ("arm: TIMEOUT: no answer", False)
+    b.event(None, "empty_survey", "nothing on the mat")  # not a reason to stop
+    assert b.stop_reason == "arm: TIMEOUT: no answer"
+    b.rig.arm = _StuckArm()
+    assert workflow.Park(b).execute(None) == "aborted"
+    assert b.park_failed and "no answer from /rascal/arm/move" in b.stop_reason

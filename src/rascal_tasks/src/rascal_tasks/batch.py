@@ -19,6 +19,10 @@ except ImportError:  # pragma: no cover - depends on the machine
     from rascal_tasks import smach
 
 
+# Events after which the machine ends the batch: the last one is why (batch.stop_reason).
+STOPPING_EVENTS = ("rig_error", "stopped", "database_error", "park_failed")
+
+
 class Batch:
     """Everything the states share: config, rig, recorder, and the sherd in hand."""
 
@@ -47,6 +51,8 @@ class Batch:
         self.pending: List[Observation] = []
         self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
         self.empty_surveys = 0
+        self.stop_reason: Optional[str] = None  # detail of the last STOPPING_EVENTS event
+        self.park_failed = False  # workflow.Park could not park the arm
         self.completed = 0  # changed only by SherdRecord._finish
         self.lost = 0  # changed only by SherdRecord._finish
         self.started = rig.clock.now()
@@ -68,6 +74,9 @@ class Batch:
     def event(self, sherd: Optional[SherdRecord], kind: str, detail: str = ""):
         """Log what happened; a sherd's events also go into its catalogue notes."""
         self.log("%s %s: %s" % ("sherd %d" % sherd.seq if sherd else "batch", kind, detail))
+        if kind in STOPPING_EVENTS:
+            self.stop_reason = detail
+            self.park_failed = self.park_failed or kind == "park_failed"
         if sherd is not None:
             sherd.note("%s: %s" % (kind, detail))
 

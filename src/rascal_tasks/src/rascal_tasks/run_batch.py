@@ -9,7 +9,6 @@ CALIBRATE, RESUME resume the unfinished sherd). Exit codes: `exit_codes.py`.
 """
 
 import os
-import re
 import signal
 import sys
 import threading
@@ -31,8 +30,6 @@ from rascal_tasks.run_lock import Busy, ContextLock, RigLock
 from rascal_tasks.workflow import Batch, build_machine, park, smach
 
 MASTER_TIMEOUT = 3.0  # s: a master that does not answer within this is not there
-# Batch events that stop the batch (batch.BatchState, workflow.Park): the last one is the reason.
-STOP_EVENT = re.compile(r"^(?:batch|sherd \d+) (rig_error|stopped|database_error|park_failed): ")
 
 
 class ProgressLine:
@@ -118,8 +115,8 @@ class Run:
         self.catalogue = None
         self.rig_lock = None
         self.context_lock = None
-        self.stop_reason = None  # the last event that stopped a batch
-        self.park_failed = False  # workflow.Park said the arm could not be parked
+        self.stop_reason = None  # why the last batch stopped (Batch.stop_reason, or the database)
+        self.park_failed = False  # the last batch could not park the arm
 
     # --- before anything moves ---
     def main(self) -> int:
@@ -208,13 +205,6 @@ class Run:
             self.batch.stop_requested.set()
             self.machine.request_preempt()
 
-    def log(self, msg):
-        rospy.loginfo(msg)
-        m = STOP_EVENT.match(msg)
-        if m:
-            self.stop_reason = msg[m.end() :]
-            self.park_failed = self.park_failed or m.group(1) == "park_failed"
-
     # --- the batch, again after a database outage ---
     def batches(self, archive) -> int:
         cfg = self.cfg
@@ -243,12 +233,13 @@ class Run:
                 if code:
                     return code
                 continue
-            batch = Batch(cfg, self.rig, recorder, self.context, progress=progress, log=self.log)
+            batch = Batch(
+                cfg, self.rig, recorder, self.context, progress=progress, log=rospy.loginfo
+            )
             if done:  # what the batch before learnt about the mat
                 batch.unpickable = done[-1].unpickable
                 batch.misses = done[-1].misses
             progress.batch = batch
-            self.stop_reason, self.park_failed = None, False
             self.batch, self.machine = batch, build_machine(batch)
             if self.stop.is_set():  # Ctrl-C while the machine was being built
                 self.machine = None
@@ -259,6 +250,7 @@ class Run:
                 return self.crashed(e)
             finally:
                 self.machine = None
+                self.stop_reason, self.park_failed = batch.stop_reason, batch.park_failed
             done.append(batch)
             print()
             if outcome == "aborted" and not self.stop.is_set() and self.database_lost():
