@@ -2,6 +2,7 @@
 master, the catalogue, and the simulator's test-only services."""
 
 import os
+import signal
 import subprocess
 import time
 
@@ -13,6 +14,7 @@ from rascal_tasks.sim_rig import SimRig
 
 WORKSPACE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIOS = os.path.join(WORKSPACE, "config", "scenarios")
+SMALL = os.path.join(SCENARIOS, "small_3.yaml")  # three sherds, one of them the scanned fragment
 
 
 def start_rig(ros_master, scenario, archive, params=None, **kw):
@@ -25,6 +27,19 @@ def start_rig(ros_master, scenario, archive, params=None, **kw):
         log_dir=ros_master.log_dir,
         **kw,
     )
+
+
+def run_batch(rig, dsn, context, timeout=800):
+    """`rascal run --context` to its end: (exit code, output). A batch that has not ended
+    after `timeout` seconds is interrupted and the test fails with its output."""
+    proc = rig.rascal("--dsn", dsn, "run", "--context", context)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=60)
+        raise AssertionError("batch did not finish:\n%s\n%s" % (out[-3000:], rig.tail())) from None
+    return proc.returncode, out
 
 
 def rascal(rig, *args, env=None):

@@ -8,43 +8,11 @@ import subprocess
 import time
 
 import pytest
-from rig_helpers import SCENARIOS, ground_truth, inject, joint_positions, migrate, rows, start_rig
+from rig_helpers import SCENARIOS, ground_truth, inject, joint_positions, rows, run_batch
 
 from rascal_tasks import exit_codes
 
 pytestmark = pytest.mark.timeout(900)
-
-SMALL = os.path.join(SCENARIOS, "small_3.yaml")
-
-
-@pytest.fixture
-def db(pg_dsn):
-    migrate(pg_dsn)
-    return pg_dsn
-
-
-def run_batch(rig, dsn, context, timeout=800):
-    proc = rig.rascal("--dsn", dsn, "run", "--context", context)
-    try:
-        out, _ = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        proc.send_signal(signal.SIGINT)
-        out, _ = proc.communicate(timeout=60)
-        raise AssertionError("batch did not finish:\n%s\n%s" % (out[-3000:], rig.tail())) from None
-    return proc.returncode, out
-
-
-@pytest.fixture
-def rig_factory(ros_master):
-    rigs = []
-
-    def make(scenario=SMALL, archive=None, params=None):
-        rigs.append(start_rig(ros_master, scenario, archive, params))
-        return rigs[-1]
-
-    yield make
-    for r in rigs:
-        r.stop()
 
 
 def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_path):

@@ -24,47 +24,16 @@ import time
 
 import pytest
 import yaml
-from rig_helpers import SCENARIOS, WORKSPACE, ground_truth, migrate, rows, start_rig
+from rig_helpers import SMALL, WORKSPACE, ground_truth, rows, run_batch
 
 pytestmark = [pytest.mark.faults, pytest.mark.timeout(900)]
 
-SMALL = os.path.join(SCENARIOS, "small_3.yaml")
 # What the run's one error line says about the arm driver (arm_controller's words).
 DRIVER_FAULT = (
     r"arm driver restarted \(.*re-run `rascal run`|driver silent: no /joint_states|"
     r"no arm joints on /joint_states within .* s; is the driver running\?|"
     r"no driver subscribes to /arm/joint_trajectory; is it running\?"
 )
-
-
-@pytest.fixture
-def db(pg_dsn):
-    migrate(pg_dsn)
-    return pg_dsn
-
-
-@pytest.fixture
-def rig_factory(ros_master):
-    rigs = []
-
-    def make(scenario=SMALL, archive=None, params=None):
-        rigs.append(start_rig(ros_master, scenario, archive, params))
-        return rigs[-1]
-
-    yield make
-    for r in rigs:
-        r.stop()
-
-
-def run_batch(rig, dsn, context, timeout=600):
-    proc = rig.rascal("--dsn", dsn, "run", "--context", context)
-    try:
-        out, _ = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        proc.send_signal(signal.SIGINT)
-        out, _ = proc.communicate(timeout=60)
-        raise AssertionError("batch did not finish:\n%s\n%s" % (out[-3000:], rig.tail())) from None
-    return proc.returncode, out
 
 
 def error_lines(out):

@@ -15,15 +15,13 @@ import psycopg2
 import pytest
 import yaml
 from rig_helpers import (
-    SCENARIOS,
+    SMALL,
     WORKSPACE,
     block_database,
     call,
     ground_truth,
-    migrate,
     rascal,
     rows,
-    start_rig,
     wait_until,
 )
 
@@ -31,30 +29,10 @@ from rascal_tasks.sim_rig import NODES, RosMaster, stop
 
 pytestmark = [pytest.mark.faults, pytest.mark.timeout(900)]
 
-SMALL = os.path.join(SCENARIOS, "small_3.yaml")
 PG_ADMIN_DSN = os.environ.get(
     "RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0.1:5432/rascal"
 )
 UNREACHABLE_DSN = "postgresql://rascal:rascal@127.0.0.1:1/nowhere"
-
-
-@pytest.fixture
-def db(pg_dsn):
-    migrate(pg_dsn)
-    return pg_dsn
-
-
-@pytest.fixture
-def rig_factory(ros_master):
-    rigs = []
-
-    def make(scenario=SMALL, archive=None, params=None, **kw):
-        rigs.append(start_rig(ros_master, scenario, archive, params, **kw))
-        return rigs[-1]
-
-    yield make
-    for r in rigs:
-        r.stop()
 
 
 def finish(proc, timeout=600):

@@ -4,25 +4,14 @@ scale made to misbehave through the simulator's /sim/inject_fault. Whatever the 
 wrong mass is committed, no sherd is taken for dropped, and every sherd is recorded once.
 Run alone with `pytest -m faults`."""
 
-import os
-import signal
-import subprocess
-
 import pytest
-from rig_helpers import SCENARIOS, ground_truth, inject, migrate, rows, start_rig
+from rig_helpers import SMALL, ground_truth, inject, rows, run_batch, start_rig
 
 pytestmark = [pytest.mark.faults, pytest.mark.timeout(900)]
 
-SMALL = os.path.join(SCENARIOS, "small_3.yaml")
 # rascal_msgs/srv/InjectFault.srv
 SCALE_UNSETTLED_TARE = 3  # the next tare catches the platform swinging: zero 3 g high
 SCALE_GLITCH_ON_LOAD = 4  # garbage, unstable readings from when the next sherd lands
-
-
-@pytest.fixture
-def db(pg_dsn):
-    migrate(pg_dsn)
-    return pg_dsn
 
 
 @pytest.fixture
@@ -30,17 +19,6 @@ def rig(ros_master, tmp_path):
     r = start_rig(ros_master, SMALL, tmp_path / "archive")
     yield r
     r.stop()
-
-
-def run_batch(rig, dsn, context, timeout=800):
-    proc = rig.rascal("--dsn", dsn, "run", "--context", context)
-    try:
-        out, _ = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        proc.send_signal(signal.SIGINT)
-        out, _ = proc.communicate(timeout=60)
-        raise AssertionError("batch did not finish:\n%s\n%s" % (out[-3000:], rig.tail())) from None
-    return proc.returncode, out
 
 
 def _summary(recorded):

@@ -1,0 +1,26 @@
+"""Fixtures of the whole-rig tests in this folder (the workspace's conftest.py holds the
+master and the database): `db`, a migrated throw-away catalogue, and `rig_factory`, which
+starts the simulator, arm_controller and sherd_detector with rosrun (rig_helpers.start_rig)
+and stops every rig it started."""
+
+import pytest
+from rig_helpers import SMALL, migrate, start_rig
+
+
+@pytest.fixture
+def db(pg_dsn):
+    migrate(pg_dsn)
+    return pg_dsn
+
+
+@pytest.fixture
+def rig_factory(ros_master):
+    rigs = []
+
+    def make(scenario=SMALL, archive=None, params=None, **kw):
+        rigs.append(start_rig(ros_master, scenario, archive, params, **kw))
+        return rigs[-1]
+
+    yield make
+    for r in rigs:
+        r.stop()
