@@ -77,6 +77,20 @@ const JointVector& surveyJoints() {
   return q;
 }
 
+bool fullyInView(const Truth& t, const rascal_perception::CameraView& view) {
+  const Eigen::Isometry3d cam_T_base = view.base_T_camera.inverse();
+  const double r = 0.5 * std::hypot(t.length, t.width) + 0.003;
+  for (int k = 0; k < 16; ++k) {
+    const double a = k * M_PI / 8;
+    const Eigen::Vector3d p(t.centre.x() + r * std::cos(a), t.centre.y() + r * std::sin(a), 0.0);
+    const Eigen::Vector2d uv = view.intrinsics.project(cam_T_base * p);
+    if (uv.x() < 5 || uv.y() < 5 || uv.x() > view.intrinsics.width - 5 || uv.y() > view.intrinsics.height - 5) {
+      return false;
+    }
+  }
+  return true;
+}
+
 Frame render(const Scenario& scenario, const JointVector& q) {
   // one simulator per arm pose, reloaded with each scenario (building one costs more than a frame)
   static std::map<JointVector, std::unique_ptr<Simulator>> cache;

@@ -29,6 +29,8 @@ struct Frame {
   std::vector<Truth> truth;
 };
 
+/// Is the truth sherd entirely in the image, 5 px from its edges (so it must be found)?
+bool fullyInView(const Truth& t, const rascal_perception::CameraView& view);
 /// The simulator as the shipped config/rascal.yaml and the URDF set it up (read once).
 const rascal_sim::SimParameters& simParameters();
 const rascal_sim::WorldLayout& layout();

@@ -2,249 +2,254 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 #include <opencv2/imgproc.hpp>
 
 namespace rascal_perception {
 
-namespace {
-constexpr double kTwoPi = 6.283185307179586;
+std::vector<std::string> flagNames(unsigned flags) {
+  static const std::pair<unsigned, const char*> kNames[] = {{kProbablySeveral, "probably_several"},
+                                                            {kTouchesBorder, "touches_border"},
+                                                            {kLowContrast, "low_contrast"},
+                                                            {kNoScale, "no_scale"}};
+  std::vector<std::string> names;
+  for (const auto& [bit, name] : kNames) {
+    if (flags & bit) names.emplace_back(name);
+  }
+  return names;
+}
 
-cv::Vec3f feature(const cv::Vec3b& hsv) {
-  const float h = hsv[0] / 256.0f, s = hsv[1] / 255.0f, v = hsv[2] / 255.0f;
-  return {s * static_cast<float>(std::cos(kTwoPi * h)), s * static_cast<float>(std::sin(kTwoPi * h)), v};
+namespace {
+constexpr int kWorkSide = 640;  // [px] contrast resolution, see contrast()
+
+/// Median of |m| over the pixels where `where` is set (every `step`-th row and column).
+double medianAbs(const cv::Mat& m, const cv::Mat& where, int step) {
+  std::vector<float> v;
+  for (int y = 0; y < m.rows; y += step) {
+    const float* p = m.ptr<float>(y);
+    const uint8_t* w = where.ptr<uint8_t>(y);
+    for (int x = 0; x < m.cols; x += step) {
+      if (w[x]) v.push_back(std::fabs(p[x]));
+    }
+  }
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+/// Lightness difference of each pixel of `lab` (CV_32FC3) to `bg` (same size), and its a*b*
+/// distance to the cloth's a*b* as a shadow would show it: a shadow dims the light, which
+/// shrinks a*b* towards grey with L*, so the cloth's a*b* is scaled by min(1, L / L_bg) first.
+void differences(const cv::Mat& lab, const cv::Mat& bg, cv::Mat& dl, cv::Mat& dab) {
+  std::vector<cv::Mat> p, b;
+  cv::split(lab, p);
+  cv::split(bg, b);
+  dl = p[0] - b[0];
+  cv::Mat dim;
+  cv::divide(p[0], cv::max(b[0], 1.0), dim);
+  dim = cv::min(dim, 1.0);
+  cv::Mat da = p[1] - 128.0f - (b[1] - 128.0f).mul(dim), db = p[2] - 128.0f - (b[2] - 128.0f).mul(dim);
+  cv::magnitude(da, db, dab);
+  // and a*b* of a dim pixel is noise (camera noise and JPEG over a few grey levels): weigh
+  // its distance by how much light it got, so deep shadows do not look coloured
+  dab = dab.mul(dim);
 }
 }  // namespace
 
-cv::Mat PhotoSegmenter::foreground(const cv::Mat& rgb, const cv::Mat& background) const {
-  const cv::Mat& source = background.empty() ? rgb : background;
-  cv::Mat hsv, hsv_src;
-  cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV_FULL);
-  cv::cvtColor(source, hsv_src, cv::COLOR_RGB2HSV_FULL);
-  const int step = std::max(1, static_cast<int>(std::sqrt(hsv_src.total() / 30000.0)));
-  std::vector<cv::Vec3f> samples;
-  for (int y = step / 2; y < hsv_src.rows; y += step) {
-    for (int x = step / 2; x < hsv_src.cols; x += step) samples.push_back(feature(hsv_src.at<cv::Vec3b>(y, x)));
+namespace {
+/// A Gaussian blur of standard deviation `sigma` approximated by three box filters: the same
+/// smoothing at a cost independent of sigma (the background's sigma is 20 cells).
+void smooth(const cv::Mat& in, cv::Mat& out, double sigma) {
+  const int w = std::max(1, cvRound(std::sqrt(4.0 * sigma * sigma + 1.0))) | 1;
+  cv::boxFilter(in, out, -1, cv::Size(w, w));
+  cv::boxFilter(out, out, -1, cv::Size(w, w));
+  cv::boxFilter(out, out, -1, cv::Size(w, w));
+}
+
+/// A smooth background from the pixels of `small` where `near` is set, refined `rounds` times
+/// from the pixels close to its own estimate (so it follows uneven light): normalised
+/// convolution, so sherds leave holes that their surroundings fill in. `support`: how much of
+/// the surface lies around each cell (0 far from it).
+void smoothBackground(const cv::Mat& small, cv::Mat& near, int rounds, double reach, const cv::Mat& spread_over,
+                      double min_piece, cv::Mat& bg, cv::Mat& support) {
+  const double sigma = std::max(small.cols, small.rows) / 8.0;
+  for (int it = 0; it < rounds; ++it) {
+    cv::erode(near, near, cv::Mat());
+    cv::Mat w, w3, num, s3;
+    near.convertTo(w, CV_32F, 1.0 / 255.0);
+    cv::merge(std::vector<cv::Mat>{w, w, w}, w3);
+    smooth(small.mul(w3), num, sigma);
+    smooth(w, support, sigma);
+    cv::merge(std::vector<cv::Mat>{support, support, support}, s3);
+    cv::divide(num, cv::max(s3, 1e-4), bg);
+    cv::Mat dl, dab;
+    differences(small, bg, dl, dab);
+    const double sl = 1.4826 * medianAbs(dl, spread_over, 1) + 1.0;
+    const double sab = 1.4826 * medianAbs(dab, spread_over, 1) + 1.0;
+    near = (cv::abs(dl) < std::max(reach * sl, 8.0)) & (dab < std::max(reach * sab, 6.0)) & (support > 0.02f);
   }
-  const int k = background.empty() ? options_.clusters : 1;
-  cv::Mat labels, centres;
-  const uint64_t saved_rng = cv::theRNG().state;  // seeded k-means, without touching others' RNG
-  cv::theRNG().state = options_.seed;
-  cv::kmeans(cv::Mat(static_cast<int>(samples.size()), 3, CV_32F, samples.data()), k, labels,
-             cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4), 3, cv::KMEANS_PP_CENTERS,
-             centres);
-  cv::theRNG().state = saved_rng;
-  std::vector<int> count(k, 0);
-  for (int i = 0; i < labels.rows; ++i) ++count[labels.at<int>(i)];
-  const int largest = static_cast<int>(std::max_element(count.begin(), count.end()) - count.begin());
-  auto nearest = [&](const cv::Vec3f& f, float* dist = nullptr) {
-    int best = 0;
-    float best_d = 1e9f;
+  // where the surface itself lies: its pixels smoothed at a finer scale (a strip of floor
+  // between a mat and the photo's edge is floor, though the mat dominates around it)
+  // only its large pieces (a sherd of its colour elsewhere is not it), with their holes
+  // filled: a sherd lying on it is on it, whatever its colour
+  std::vector<std::vector<cv::Point>> outlines, large;
+  cv::findContours(near, outlines, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  for (auto& o : outlines) {
+    if (cv::contourArea(o) >= min_piece * near.total()) large.push_back(std::move(o));
+  }
+  cv::Mat filled = cv::Mat::zeros(near.size(), CV_8U), w;
+  cv::drawContours(filled, large, -1, cv::Scalar(255), cv::FILLED);
+  // ... but only sherd-sized holes: a surface-sized hole is another surface (a sheet on the
+  // floor is a hole in the floor)
+  cv::Mat holes = filled & ~near, cc, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(holes, cc, stats, centroids, 4, CV_32S);
+  for (int i = 1; i < n; ++i) {
+    if (stats.at<int>(i, cv::CC_STAT_AREA) >= min_piece * near.total()) filled.setTo(0, cc == i);
+  }
+  filled.convertTo(w, CV_32F, 1.0 / 255.0);
+  smooth(w, support, sigma / 4);
+}
+}  // namespace
+
+cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background, PhotoResult& r) const {
+  // Contrast is computed on at most kWorkSide pixels along the longer side and interpolated
+  // back: it is smooth at the scale of a pixel, and this is most of the time per photo.
+  cv::Mat rgb = full;
+  const int longer = std::max(full.cols, full.rows);
+  if (longer > kWorkSide) {
+    const double k = static_cast<double>(kWorkSide) / longer;
+    cv::resize(full, rgb, cv::Size(cvRound(full.cols * k), cvRound(full.rows * k)), 0, 0, cv::INTER_AREA);
+  }
+  // Lab: L* and a*b* separate light from colour, and distances in it are roughly perceptual
+  cv::Mat lab;
+  cv::cvtColor(rgb, lab, cv::COLOR_RGB2Lab);
+  lab.convertTo(lab, CV_32F);
+  // The background on a coarse grid (about 160 cells across): cheap, and sherds smaller than
+  // the smoothing scale do not pull it.
+  const int f = std::max(1, cvRound(std::max(rgb.cols, rgb.rows) / 160.0));
+  const cv::Size coarse(std::max(1, rgb.cols / f), std::max(1, rgb.rows / f));
+  cv::Mat small;
+  cv::resize(lab, small, coarse, 0, 0, cv::INTER_AREA);
+  // One smooth background per surface: the cloth, and where the photo's rim is mostly
+  // something else (floor, table, frame), that too; a pixel's contrast is to the nearer one.
+  std::vector<cv::Mat> bgs, supports;
+  cv::Mat quiet_cloth;  // full resolution: the cells the cloth's estimate was made from
+  if (!background.empty()) {  // an empty-background photo is the model itself
+    cv::Mat empty;
+    cv::cvtColor(background, empty, cv::COLOR_RGB2Lab);
+    empty.convertTo(empty, CV_32F);
+    cv::resize(empty, empty, rgb.size(), 0, 0, cv::INTER_AREA);  // compared pixel by pixel
+    bgs.push_back(empty);
+    supports.push_back(cv::Mat(coarse, CV_32F, cv::Scalar(1)));
+  } else {
+    // the cloth: the largest of a few k-means colours (seeded; others' RNG untouched) as a
+    // start, then the smooth estimate
+    cv::Mat samples = small.reshape(1, static_cast<int>(small.total())), labels, centres;
+    const uint64_t saved_rng = cv::theRNG().state;
+    cv::theRNG().state = 1;
+    const int k = std::max(2, options_.clusters);
+    cv::kmeans(samples, k, labels, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.5), 1,
+               cv::KMEANS_PP_CENTERS, centres);
+    cv::theRNG().state = saved_rng;
+    labels = labels.reshape(1, coarse.height);
+    int largest = 0;
+    for (int c = 1; c < k; ++c) {
+      if (cv::countNonZero(labels == c) > cv::countNonZero(labels == largest)) largest = c;
+    }
+    // one large connected piece of another colour, larger than any sherd, is a second
+    // surface (a mat on a table): sherds are many pieces, a surface is one
+    std::vector<cv::Mat> pieces(k);
     for (int c = 0; c < k; ++c) {
-      const float* m = centres.ptr<float>(c);
-      const float d = (f[0] - m[0]) * (f[0] - m[0]) + (f[1] - m[1]) * (f[1] - m[1]) + (f[2] - m[2]) * (f[2] - m[2]);
-      if (d < best_d) {
-        best_d = d;
-        best = c;
+      if (c == largest) continue;
+      cv::Mat piece = labels == c, cc, stats, centroids;
+      cv::erode(piece, piece, cv::Mat());
+      const int m = cv::connectedComponentsWithStats(piece, cc, stats, centroids, 4, CV_32S);
+      for (int i = 1; i < m; ++i) {
+        if (stats.at<int>(i, cv::CC_STAT_AREA) > options_.surface_fraction * small.total()) pieces[c] = cc == i;
       }
     }
-    if (dist) *dist = best_d;
-    return best;
-  };
-  // background: the largest cluster and every cluster that holds a tenth of the image's rim
-  // (sherds and the bar lie inside the photo; the cloth's shades all reach its edges)
-  std::vector<int> rim(k, 0);
-  int rim_total = 0;
-  const int band = std::max(2, std::min(hsv_src.rows, hsv_src.cols) / 50);
-  for (int y = 0; y < hsv_src.rows; y += 2) {
-    for (int x = 0; x < hsv_src.cols; x += 2) {
-      if (y >= band && y < hsv_src.rows - band && x >= band && x < hsv_src.cols - band) continue;
-      ++rim[nearest(feature(hsv_src.at<cv::Vec3b>(y, x)))];
-      ++rim_total;
+    const bool two_surfaces = std::any_of(pieces.begin(), pieces.end(), [](const cv::Mat& p) { return !p.empty(); });
+    // the cloth's spread over the whole photo (loose while the estimate is still rough),
+    // unless the photo is two surfaces, whose spread together says nothing of either
+    cv::Mat bg, support, near = labels == largest;
+    smoothBackground(small, near, 3, 2.5, two_surfaces ? near.clone() : cv::Mat(coarse, CV_8U, cv::Scalar(1)),
+                     options_.surface_fraction / 3, bg, support);
+    cv::resize(near, quiet_cloth, rgb.size(), 0, 0, cv::INTER_NEAREST);
+    bgs.push_back(bg);
+    supports.push_back(support);
+    // Trust: the rim should be mostly cloth (sherds lie inside the photo). Where it is not,
+    // what it shows instead (floor, a table, a frame) is a second surface.
+    cv::Mat dl, dab;
+    differences(small, bg, dl, dab);
+    const double sl = 1.4826 * medianAbs(dl, labels == largest, 1) + 1.0;
+    const double sab = 1.4826 * medianAbs(dab, labels == largest, 1) + 1.0;
+    const cv::Mat cloth = (cv::abs(dl) < std::max(3.0 * sl, 8.0)) & (dab < std::max(3.0 * sab, 6.0));
+    const int band = std::max(1, std::min(coarse.width, coarse.height) / 25);
+    cv::Mat rim(coarse, CV_8U, cv::Scalar(255));
+    rim(cv::Rect(band, band, coarse.width - 2 * band, coarse.height - 2 * band)).setTo(0);
+    const double on_cloth = static_cast<double>(cv::countNonZero(cloth & rim)) / cv::countNonZero(rim);
+    if (on_cloth < 0.6) {
+      r.background_trusted = false;
+      char line[160];
+      std::snprintf(line, sizeof line, "background doubtful: only %.0f %% of the photo's rim looks like the cloth",
+                    100.0 * on_cloth);
+      r.warnings.emplace_back(line);
+    }
+    // Other surfaces: the large pieces above, and a colour holding a tenth of the rim where
+    // the rim is not cloth (the floor, a frame)
+    const cv::Mat other = rim & ~cloth;
+    const double rim_cells = cv::countNonZero(rim);
+    for (int c = 0; c < k; ++c) {
+      if (c == largest) continue;
+      const bool on_rim = on_cloth < 0.8 && cv::countNonZero(other & (labels == c)) > 0.1 * rim_cells;
+      if (!on_rim && pieces[c].empty()) continue;
+      cv::Mat bg2, support2, near2 = pieces[c].empty() ? cv::Mat((labels == c) & ~cloth) : pieces[c];
+      // its spread over its own first pixels: the whole photo is mostly cloth
+      smoothBackground(small, near2, 2, 4.0, near2.clone(), options_.surface_fraction / 3, bg2, support2);
+      bgs.push_back(bg2);
+      supports.push_back(support2);
     }
   }
-  std::vector<bool> is_bg(k, false);
-  for (int c = 0; c < k; ++c) {
-    is_bg[c] = c == largest || rim[c] >= 0.1 * rim_total ||
-               cv::norm(centres.row(c) - centres.row(largest)) < options_.background_distance;
+  // per surface: lightness and shadow-aware chroma difference at full resolution; the unit
+  // is that surface's own spread (texture, lint, noise) over the pixels close to it
+  std::vector<cv::Mat> scores, full_supports;
+  for (size_t i = 0; i < bgs.size(); ++i) {
+    cv::Mat bg_full, dl, dab;
+    cv::resize(bgs[i], bg_full, rgb.size(), 0, 0, cv::INTER_LINEAR);
+    differences(lab, bg_full, dl, dab);
+    const cv::Mat quiet = i == 0 && !quiet_cloth.empty() ? quiet_cloth : cv::Mat((cv::abs(dl) < 12.0) & (dab < 8.0));
+    const int step = std::max(1, static_cast<int>(std::sqrt(rgb.total() / 60000.0)));
+    const double sl = std::max(options_.min_contrast_l, 1.4826 * medianAbs(dl, quiet, step));
+    const double sab = std::max(options_.min_contrast_ab, 1.4826 * medianAbs(dab, quiet, step));
+    // Lighter than the surface, or another chromaticity. Darker with the surface's (dimmed)
+    // chromaticity is a shadow, so darker counts only where the chromaticity also differs
+    // (dark paint, brown clay on grey cloth).
+    cv::Mat lighter = dl / sl, colour = dab / sab, darker = -dl / sl;
+    darker.setTo(0, colour < 2.0);
+    cv::Mat s_i = cv::max(cv::max(lighter, colour), darker);
+    cv::Mat support;
+    cv::resize(supports[i], support, rgb.size(), 0, 0, cv::INTER_LINEAR);
+    scores.push_back(s_i);
+    full_supports.push_back(support);
   }
-  cv::Mat fg(rgb.size(), CV_8U);
-  for (int y = 0; y < hsv.rows; ++y) {
-    const cv::Vec3b* p = hsv.ptr<cv::Vec3b>(y);
-    uint8_t* o = fg.ptr<uint8_t>(y);
-    for (int x = 0; x < hsv.cols; ++x) {
-      float best_d = 0.0f;
-      const int best = nearest(feature(p[x]), &best_d);
-      if (background.empty()) {
-        o[x] = is_bg[best] ? 0 : 255;
-      } else {
-        o[x] = best_d > options_.background_distance * options_.background_distance ? 255 : 0;
-      }
+  // a pixel is compared with the surface it lies on (the one most present around it), and
+  // with any other nearly as present (near the edge between two)
+  cv::Mat score;
+  if (scores.size() == 1) {
+    score = scores[0];
+  } else {
+    cv::Mat most = full_supports[0].clone();
+    for (size_t i = 1; i < scores.size(); ++i) most = cv::max(most, full_supports[i]);
+    score = cv::Mat(rgb.size(), CV_32F, cv::Scalar(1e6));
+    for (size_t i = 0; i < scores.size(); ++i) {
+      cv::Mat s_i = scores[i];
+      s_i.setTo(1e6, full_supports[i] < 0.25 * most);
+      score = cv::min(score, s_i);
     }
   }
-  cv::morphologyEx(fg, fg, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
-
-  // dark glaze and painted lines must not cut a sherd in pieces
-  const int close = std::max(3, (rgb.cols / 200) | 1);
-  cv::morphologyEx(fg, fg, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(close, close)));
-  return fg;
-}
-
-ScaleBar PhotoSegmenter::findBar(const cv::Mat& rgb, std::vector<Blob>& blobs) const {
-  ScaleBar bar;
-  double best = 0.0;
-  int index = -1;
-  cv::Mat hsv;
-  cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV_FULL);
-  for (size_t i = 0; i < blobs.size(); ++i) {
-    const Blob& b = blobs[i];
-    const double lo = std::min(b.box.size.width, b.box.size.height);
-    const double hi = std::max(b.box.size.width, b.box.size.height);
-    if (lo <= 0) continue;
-    const double aspect = hi / lo;
-    if (aspect < options_.bar_aspect_min || aspect > options_.bar_aspect_max) continue;
-    const double fill = b.pixels / (lo * hi);
-    if (fill < 0.85) continue;
-    const double saturation = cv::mean(hsv(b.bounds), b.mask)[1] / 255.0;
-    if (saturation > 0.35) continue;
-    if (fill > best) {
-      best = fill;
-      index = static_cast<int>(i);
-    }
-  }
-  if (index < 0) return bar;
-  bar.found = true;
-  bar.box = blobs[index].box;
-  const double lo = std::min(bar.box.size.width, bar.box.size.height);
-  const double hi = std::max(bar.box.size.width, bar.box.size.height);
-  // A bar with a chequered half: its black parts may vanish into a dark cloth, leaving the white
-  // row of the solid half (bar_length / 2 x 1 cm) and the white squares of the chequer beside it,
-  // along its axis and as wide as it is tall. Then the rectangle is half the bar.
-  const cv::Point2f axis = bar.box.size.width >= bar.box.size.height
-                               ? cv::Point2f(std::cos(bar.box.angle * 0.0174533f), std::sin(bar.box.angle * 0.0174533f))
-                               : cv::Point2f(-std::sin(bar.box.angle * 0.0174533f), std::cos(bar.box.angle * 0.0174533f));
-  std::vector<size_t> squares;
-  for (size_t i = 0; i < blobs.size(); ++i) {
-    if (static_cast<int>(i) == index) continue;
-    const Blob& b = blobs[i];
-    const double a = std::min(b.box.size.width, b.box.size.height), c = std::max(b.box.size.width, b.box.size.height);
-    if (a < 0.6 * lo || c > 1.5 * lo || b.pixels < 0.7 * a * c) continue;
-    const cv::Point2f d = b.box.center - bar.box.center;
-    const double along = d.x * axis.x + d.y * axis.y, across = -d.x * axis.y + d.y * axis.x;
-    if (std::fabs(along) > 1.7 * hi || std::fabs(across) > 1.5 * lo) continue;
-    squares.push_back(i);
-  }
-  const bool half = squares.size() >= 2;
-  bar.px_per_cm = hi / (half ? 0.5 * options_.bar_length_cm : options_.bar_length_cm);
-  squares.push_back(static_cast<size_t>(index));
-  std::sort(squares.rbegin(), squares.rend());
-  if (half) {  // report the whole bar: the white row and the chequer
-    std::vector<cv::Point> pts;
-    for (size_t i : squares) pts.insert(pts.end(), blobs[i].contour.begin(), blobs[i].contour.end());
-    bar.box = cv::minAreaRect(pts);
-  }
-  for (size_t i : squares) {
-    if (half || i == static_cast<size_t>(index)) blobs.erase(blobs.begin() + static_cast<long>(i));
-  }
-  // Refine the length from the image: the bar (black and white) is brighter than the cloth
-  // around it, so the mean value across the bar's width, along its axis, steps up at both ends.
-  const double estimate = bar.px_per_cm * options_.bar_length_cm;
-  const double half_width = half ? lo : 0.5 * lo;  // the bar is 2 cm wide; the white row 1 cm
-  const cv::Point2f across(-axis.y, axis.x);
-  const cv::Point2f centre = bar.box.center;
-  const int reach = static_cast<int>(1.5 * estimate);
-  std::vector<double> profile(2 * reach + 1, 0.0);
-  for (int t = -reach; t <= reach; ++t) {
-    double sum = 0.0;
-    int n = 0;
-    for (double k = -0.8 * half_width; k <= 0.8 * half_width; k += 1.0) {
-      const cv::Point2f p = centre + static_cast<float>(t) * axis + static_cast<float>(k) * across;
-      const int x = cvRound(p.x), y = cvRound(p.y);
-      if (x < 0 || y < 0 || x >= hsv.cols || y >= hsv.rows) continue;
-      sum += hsv.at<cv::Vec3b>(y, x)[2];
-      ++n;
-    }
-    profile[t + reach] = n ? sum / n : 0.0;
-  }
-  std::vector<double> inside, outside;
-  for (int t = -reach; t <= reach; ++t) {
-    if (std::abs(t) < 0.3 * estimate) inside.push_back(profile[t + reach]);
-    if (std::abs(t) > 0.7 * estimate) outside.push_back(profile[t + reach]);
-  }
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
-  if (!inside.empty() && !outside.empty()) {
-    const double level = 0.5 * (median(inside) + median(outside));
-    // walk out from the middle of the bar to the first crossing on each side (sub-pixel)
-    int mid = 0;  // the bar position nearest the box centre
-    for (int d = 0; d <= reach; ++d) {
-      if (profile[reach + d] > level) {
-        mid = d;
-        break;
-      }
-      if (profile[reach - d] > level) {
-        mid = -d;
-        break;
-      }
-    }
-    auto edge = [&](int dir) {
-      for (int t = mid; std::abs(t + dir) <= reach; t += dir) {
-        const double a = profile[t + reach], b = profile[t + dir + reach];
-        if (a > level && b <= level) return t + dir * (a - level) / (a - b);
-      }
-      return static_cast<double>(dir * reach);
-    };
-    const double length = edge(+1) - edge(-1);
-    if (length > 0.8 * estimate && length < 1.25 * estimate) bar.px_per_cm = length / options_.bar_length_cm;
-  }
-  return bar;
-}
-
-namespace {
-/// True if the masks of a and b come within `gap` pixels.
-bool within(const Blob& a, const Blob& b, int gap) {
-  const cv::Rect ra(a.bounds.x - gap, a.bounds.y - gap, a.bounds.width + 2 * gap, a.bounds.height + 2 * gap);
-  const cv::Rect both = ra & b.bounds;
-  if (both.empty()) return false;
-  cv::Mat grown = cv::Mat::zeros(ra.size(), CV_8U);
-  a.mask.copyTo(grown(cv::Rect(gap, gap, a.bounds.width, a.bounds.height)));
-  cv::dilate(grown, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * gap + 1, 2 * gap + 1)));
-  const cv::Mat ga = grown(cv::Rect(both.tl() - ra.tl(), both.size()));
-  const cv::Mat gb = b.mask(cv::Rect(both.tl() - b.bounds.tl(), both.size()));
-  return cv::countNonZero(ga & gb) > 0;
-}
-}  // namespace
-
-void PhotoSegmenter::mergeFragments(std::vector<Blob>& blobs, const cv::Size& size) const {
-  // pieces of one sherd cut apart by dark glaze or paint: a much smaller blob close to a larger one
-  // (smaller than any sherd, or a tenth of its neighbour, within 2 % of the photo's width)
-  const int far = std::max(4, size.width / 50);
-  const double tiny = 0.025 * size.width;
-  bool merged = true;
-  while (merged) {
-    merged = false;
-    for (size_t i = 0; i < blobs.size() && !merged; ++i) {
-      for (size_t j = 0; j < blobs.size() && !merged; ++j) {
-        if (i == j) continue;
-        const double ratio = static_cast<double>(blobs[i].pixels) / blobs[j].pixels;
-        if (ratio >= 0.5) continue;
-        const double side = std::max(blobs[i].box.size.width, blobs[i].box.size.height);
-        if (!(ratio < 0.15 || side < tiny) || !within(blobs[i], blobs[j], far)) continue;
-        const cv::Rect all = blobs[i].bounds | blobs[j].bounds;
-        const cv::Rect canvas =
-            cv::Rect(all.x - far, all.y - far, all.width + 2 * far, all.height + 2 * far) & cv::Rect(cv::Point(0, 0), size);
-        cv::Mat m = cv::Mat::zeros(canvas.size(), CV_8U);
-        for (size_t k : {i, j}) blobs[k].mask.copyTo(m(cv::Rect(blobs[k].bounds.tl() - canvas.tl(), blobs[k].bounds.size())), blobs[k].mask);
-        cv::morphologyEx(m, m, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * far + 1, 2 * far + 1)));
-        Blob b = SherdSegmenter::blobOf(m, canvas.tl());
-        if (b.contour.empty()) continue;
-        blobs[j] = std::move(b);
-        blobs.erase(blobs.begin() + static_cast<long>(i));
-        merged = true;
-      }
-    }
-  }
+  if (score.size() != full.size()) cv::resize(score, score, full.size(), 0, 0, cv::INTER_LINEAR);
+  return score;
 }
 
 namespace {
@@ -341,26 +346,155 @@ void PhotoSegmenter::splitAtSeams(std::vector<Blob>& blobs, const cv::Mat& rgb) 
   blobs = std::move(out);
 }
 
+namespace {
+/// Clears foreground rows and columns near the border that are mostly foreground along their
+/// whole length: a frame or mount around an edited photo, or the cloth's lit edge, never a row
+/// of sherds (they lie apart on the cloth). Sherds touching the strip are kept.
+void removeFrame(cv::Mat& fg, PhotoResult& r) {
+  const int depth_x = std::max(2, fg.cols / 25), depth_y = std::max(2, fg.rows / 25);
+  cv::Mat rows, cols;
+  cv::reduce(fg, rows, 1, cv::REDUCE_AVG, CV_32F);  // one value per row
+  cv::reduce(fg, cols, 0, cv::REDUCE_AVG, CV_32F);  // one value per column
+  constexpr float kFull = 0.5f * 255.0f;
+  int cleared = 0;
+  auto strip = [&](const cv::Mat& profile, int n, int depth, bool is_row) {
+    for (int side = 0; side < 2; ++side) {
+      int last = -1;  // the innermost full line within `depth` of this side
+      for (int k = 0; k < depth; ++k) {
+        const int i = side ? n - 1 - k : k;
+        if (profile.at<float>(is_row ? i : 0, is_row ? 0 : i) >= kFull) last = k;
+      }
+      for (int k = 0; k <= last; ++k) {
+        const int i = side ? n - 1 - k : k;
+        (is_row ? fg.row(i) : fg.col(i)).setTo(0);
+      }
+      cleared += last + 1;
+    }
+  };
+  strip(rows, fg.rows, depth_y, true);
+  strip(cols, fg.cols, depth_x, false);
+  if (cleared > 0) r.warnings.emplace_back("a frame or strip along the photo's border was left out");
+}
+}  // namespace
+
 PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& background) const {
   PhotoResult r;
-  r.foreground = foreground(rgb, background);
+  if (rgb.empty() || rgb.type() != CV_8UC3) throw std::invalid_argument("PhotoSegmenter::segment: not an RGB image");
+  ScaleBarOptions bar_options;
+  bar_options.bar_length_cm = options_.bar_length_cm;
+  r.bar = findScaleBar(rgb, bar_options);
+  const double longer = std::max(rgb.cols, rgb.rows);
+  const cv::Mat score = contrast(rgb, background, r);
+  // hysteresis: weak pixels are kept where their connected region holds a strong one, so a
+  // sherd keeps its dark paint and low-contrast rim but cloth texture does not grow blobs
+  cv::Mat labels;
+  const int n = cv::connectedComponents(score > options_.weak_contrast, labels, 8, CV_32S);
+  std::vector<uint8_t> keep(n, 0);
+  const cv::Mat strong = score > options_.strong_contrast;
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    const uint8_t* s = strong.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (s[x]) keep[l[x]] = 255;
+    }
+  }
+  keep[0] = 0;
+  cv::Mat fg(rgb.size(), CV_8U);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    uint8_t* o = fg.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) o[x] = keep[l[x]];
+  }
+  // Sizes in mm from the bar; without it, from the typical sherd (the blob size a foreground
+  // pixel belongs to, median over pixels so lint does not count), taken as kTypicalSherdMm.
+  double px_per_mm = r.bar.found ? 0.1 * r.bar.px_per_cm : 0.0;
+  if (!r.bar.found) {
+    cv::Mat cc, stats, centroids;
+    const int m = cv::connectedComponentsWithStats(fg, cc, stats, centroids, 8, CV_32S);
+    std::vector<std::pair<int, int>> sizes;  // (area, area) weighted by area
+    long total = 0;
+    for (int i = 1; i < m; ++i) {
+      sizes.emplace_back(stats.at<int>(i, cv::CC_STAT_AREA), 0);
+      total += stats.at<int>(i, cv::CC_STAT_AREA);
+    }
+    std::sort(sizes.begin(), sizes.end());
+    long seen = 0;
+    double typical = 0.0;
+    for (const auto& sz : sizes) {
+      seen += sz.first;
+      if (2 * seen >= total) {
+        typical = sz.first;
+        break;
+      }
+    }
+    px_per_mm = std::clamp(std::sqrt(typical) / options_.typical_sherd_mm, longer / 1500.0, longer / 150.0);
+  }
+  const double min_side = options_.min_side_mm * px_per_mm;
+  const int radius = std::max(1, cvRound(options_.clean_radius_mm * px_per_mm));
+  // close pinholes and paint cracks, then open away lint and scratches
+  cv::morphologyEx(fg, fg, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  cv::morphologyEx(fg, fg, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(4 * radius + 1, 4 * radius + 1)));
+  removeFrame(fg, r);
+  std::vector<cv::Point2f> bar_corners;
+  if (r.bar.found) {  // the bar and its card are not sherds
+    cv::RotatedRect grown = r.bar.box;
+    grown.size.width += static_cast<float>(2 * options_.bar_margin_cm * r.bar.px_per_cm);
+    grown.size.height += static_cast<float>(2 * options_.bar_margin_cm * r.bar.px_per_cm);
+    bar_corners.resize(4);
+    grown.points(bar_corners.data());
+    std::vector<cv::Point> poly(bar_corners.begin(), bar_corners.end());
+    cv::fillConvexPoly(fg, poly, cv::Scalar(0));
+  }
+  r.foreground = fg;
+
   SegmentationOptions o;
-  o.min_side_px = options_.min_side_fraction * rgb.cols;
-  o.max_side_px = options_.max_side_fraction * std::max(rgb.cols, rgb.rows);
-  o.border_margin = 2;
+  o.min_side_px = min_side;
+  o.max_side_px = r.bar.found ? options_.max_side_mm * px_per_mm : options_.max_side_fraction * longer;
+  o.border_margin = 0;  // sherds cut by the border count (flagged)
   o.split_min_neck = options_.split_min_neck;
-  std::vector<Blob> blobs = SherdSegmenter().blobs(r.foreground, o);
-  r.bar = findBar(rgb, blobs);
+  std::vector<Blob> blobs = SherdSegmenter().blobs(fg, o);
   splitAtSeams(blobs, rgb);
-  mergeFragments(blobs, rgb.size());
+
+  std::vector<double> areas;
+  for (const Blob& b : blobs) areas.push_back(b.pixels);
+  double typical = 0.0;
+  if (!areas.empty()) {
+    std::nth_element(areas.begin(), areas.begin() + areas.size() / 2, areas.end());
+    typical = areas[areas.size() / 2];
+  }
   const double mm_per_px = r.bar.found ? 10.0 / r.bar.px_per_cm : 0.0;
+  bool strip_warned = false;
   for (Blob& b : blobs) {
+    if (!bar_corners.empty() && cv::pointPolygonTest(bar_corners, b.box.center, false) >= 0) continue;
     PhotoSherd s;
     const cv::Scalar c = cv::mean(rgb(b.bounds), b.mask);
     s.colour = cv::Vec3d(c[0], c[1], c[2]) / 255.0;
     s.length_mm = std::max(b.box.size.width, b.box.size.height) * mm_per_px;
     s.width_mm = std::min(b.box.size.width, b.box.size.height) * mm_per_px;
     s.area_mm2 = b.pixels * mm_per_px * mm_per_px;
+    if (!r.bar.found) s.flags |= kNoScale;
+    const bool left = b.bounds.x <= 1, top = b.bounds.y <= 1;
+    const bool right = b.bounds.br().x >= rgb.cols - 1, bottom = b.bounds.br().y >= rgb.rows - 1;
+    if (left || right || top || bottom) {
+      // a thin strip along the border (frame, mount, the cloth's edge) is not a sherd cut by it
+      const bool vertical = (left || right) && b.bounds.width <= 0.04 * rgb.cols && b.bounds.height >= 3 * b.bounds.width;
+      const bool horizontal = (top || bottom) && b.bounds.height <= 0.04 * rgb.rows && b.bounds.width >= 3 * b.bounds.height;
+      if (vertical || horizontal) {
+        if (!strip_warned) r.warnings.emplace_back("a strip along the photo's border was left out (frame?)");
+        strip_warned = true;
+        continue;
+      }
+      s.flags |= kTouchesBorder;
+    }
+    // several sherds the split could not separate: far from convex, or far larger than the rest
+    if (solidity(b.contour) < 0.8 || (blobs.size() >= 5 && b.pixels > 4.0 * typical)) s.flags |= kProbablySeveral;
+    // how much of it stands out clearly: a sherd mostly below the strong contrast (dark on a
+    // dark cloth) has an outline that may be wrong
+    const double clear = static_cast<double>(cv::countNonZero(strong(b.bounds) & b.mask)) / std::max(1, b.pixels);
+    if (clear < options_.min_clear) continue;  // cloth texture or a shadow edge, not a sherd
+    if (clear < options_.low_contrast) s.flags |= kLowContrast;
     s.blob = std::move(b);
     r.sherds.push_back(std::move(s));
   }
