@@ -239,6 +239,13 @@ cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background,
   if (scores.size() == 1) {
     score = scores[0];
   } else {
+    // the cloth is what the photo is of: where no other surface is present, a pixel lies on it,
+    // even inside a large hole of its own presence (a hotspot or a shadowed half of the cloth
+    // that its smooth estimate left out is still cloth, not 'no surface')
+    cv::Mat others = full_supports[1].clone();
+    for (size_t i = 2; i < scores.size(); ++i) others = cv::max(others, full_supports[i]);
+    cv::Mat absent = 1.0 - others;
+    full_supports[0] = cv::max(full_supports[0], absent);
     cv::Mat most = full_supports[0].clone();
     for (size_t i = 1; i < scores.size(); ++i) most = cv::max(most, full_supports[i]);
     score = cv::Mat(rgb.size(), CV_32F, cv::Scalar(1e6));

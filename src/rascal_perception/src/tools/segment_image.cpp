@@ -1,11 +1,12 @@
-// segment_image: sherds and the scale bar in a photo (no ROS).
-//   segment_image <photo> [--background auto|<empty.jpg>] [--json out.json] [--png out.png]
-//                 [--mask foreground.png] [--bar-length 10] [--clusters 6]
-// Prints the JSON to stdout when --json is not given.
+// segment_image: sherds and the scale bar in a photo (no ROS). `segment_image --help` says it all.
+#include <getopt.h>
+
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -16,50 +17,130 @@
 using namespace rascal_perception;
 
 namespace {
-int usage(FILE* to = stderr, int code = 2) {
-  std::fprintf(to,
-               "usage: segment_image <photo> [--background auto|<empty.jpg>] [--json out.json] [--png out.png]\n"
-               "                     [--mask foreground.png] [--bar-length cm] [--clusters k]\n"
-               "Finds the sherds and the black/white scale bar in a photo; prints JSON (sizes in mm when\n"
-               "the bar is found). --background auto learns the background from the photo itself.\n");
-  return code;
+constexpr int kConfident = 0, kDoubtful = 1, kBadInput = 2;
+
+const char* kHelp =
+    "usage: segment_image PHOTO [options]        (options may come before or after the photo)\n"
+    "\n"
+    "Finds every sherd and the 10 cm scale bar (half a chequer of 1 cm squares, half solid) in a\n"
+    "photo of sherds on a cloth, and measures each sherd in mm once the bar is found.\n"
+    "\n"
+    "options:\n"
+    "  --json FILE          write the result as JSON to FILE ('-': to stdout instead of the table)\n"
+    "  --overlay FILE       write the overlay image there (default: PHOTO-STEM_segmented.jpg in the\n"
+    "                       current folder): outlines and ids, flagged sherds in orange, the bar\n"
+    "  --no-overlay         write no overlay image\n"
+    "  --mask FILE          write the foreground mask (PNG)\n"
+    "  --background FILE    a photo of the empty cloth from the same camera (default: learnt from\n"
+    "                       the photo itself)\n"
+    "  --bar-length CM      printed length of the scale bar (default 10)\n"
+    "  --clusters K         colours of the first background guess, 2..12 (default 6)\n"
+    "  -h, --help           this text\n"
+    "\n"
+    "table columns: id, length and width of the sherd's smallest enclosing rectangle [mm],\n"
+    "area of its outline [mm2] (px and px2 without a scale bar), flags.\n"
+    "flags: probably_several (shape or size says several touching sherds), touches_border (the\n"
+    "sherd may be cut by the photo's edge), low_contrast (outline weak against the cloth),\n"
+    "no_scale (no scale bar: sizes in px).\n"
+    "exit codes: 0 a confident result; 1 doubtful (no scale bar, a doubtful bar, a sherd\n"
+    "flagged, or the background model not trusted: the summary line says which); 2 bad usage or\n"
+    "an unreadable photo (one line on stderr).\n";
+
+int badUsage(const std::string& line) {
+  std::fprintf(stderr, "segment_image: %s (segment_image --help lists the options)\n", line.c_str());
+  return kBadInput;
 }
 
-cv::Mat readRgb(const std::string& path) {
+cv::Mat readRgb(const std::string& path, const char* what) {
+  if (!std::filesystem::is_regular_file(path)) {
+    throw std::runtime_error(std::string(what) + " '" + path + "' does not exist; check the path");
+  }
   cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
-  if (bgr.empty()) throw std::runtime_error("cannot read " + path);
+  if (bgr.empty()) {
+    throw std::runtime_error(std::string(what) + " '" + path + "' cannot be read as an image; check the path");
+  }
   cv::Mat rgb;
   cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
   return rgb;
+}
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    o += c;
+  }
+  return o;
+}
+
+/// Photo-wide doubts, one phrase each (empty: a confident result).
+std::vector<std::string> doubts(const PhotoResult& r) {
+  std::vector<std::string> d;
+  if (!r.bar.found) d.push_back("no scale bar: sizes in px");
+  if (r.bar.found && !r.bar.doubt.empty()) d.push_back("scale bar doubtful: " + r.bar.doubt);
+  for (const std::string& w : r.warnings) d.push_back(w);
+  if (!r.background_trusted && r.warnings.empty()) d.push_back("background model not trusted");
+  int flagged = 0;
+  for (const PhotoSherd& s : r.sherds) flagged += (s.flags & ~static_cast<unsigned>(kNoScale)) != 0;
+  if (flagged) d.push_back(std::to_string(flagged) + " sherd" + (flagged == 1 ? "" : "s") + " flagged");
+  return d;
 }
 
 std::string json(const std::string& image, const cv::Mat& rgb, const PhotoResult& r) {
   std::ostringstream o;
   o.setf(std::ios::fixed);
   o.precision(2);
-  o << "{\n  \"image\": \"" << image << "\",\n  \"width\": " << rgb.cols << ",\n  \"height\": " << rgb.rows << ",\n";
+  o << "{\n  \"image\": \"" << escape(image) << "\",\n  \"width\": " << rgb.cols << ",\n  \"height\": " << rgb.rows
+    << ",\n";
   if (r.bar.found) {
     const cv::RotatedRect& b = r.bar.box;
     o << "  \"px_per_cm\": " << r.bar.px_per_cm << ",\n  \"scale_bar\": {\"centre\": [" << b.center.x << ", "
       << b.center.y << "], \"length_px\": " << std::max(b.size.width, b.size.height)
-      << ", \"width_px\": " << std::min(b.size.width, b.size.height) << ", \"angle_deg\": " << b.angle << "},\n";
+      << ", \"width_px\": " << std::min(b.size.width, b.size.height) << ", \"angle_deg\": " << b.angle
+      << ", \"squares\": " << r.bar.squares << ", \"doubt\": "
+      << (r.bar.doubt.empty() ? "null" : "\"" + escape(r.bar.doubt) + "\"") << "},\n";
   } else {
     o << "  \"px_per_cm\": null,\n  \"scale_bar\": null,\n";
   }
-  o << "  \"sherds\": [";
+  o << "  \"background_trusted\": " << (r.background_trusted ? "true" : "false") << ",\n  \"doubts\": [";
+  const std::vector<std::string> d = doubts(r);
+  for (size_t i = 0; i < d.size(); ++i) o << (i ? ", " : "") << "\"" << escape(d[i]) << "\"";
+  o << "],\n  \"sherds\": [";
   for (size_t i = 0; i < r.sherds.size(); ++i) {
     const PhotoSherd& s = r.sherds[i];
     const cv::RotatedRect& b = s.blob.box;
-    o << (i ? ",\n" : "\n") << "    {\"id\": " << i << ", \"centre_px\": [" << b.center.x << ", " << b.center.y
+    o << (i ? ",\n" : "\n") << "    {\"id\": " << i + 1 << ", \"centre_px\": [" << b.center.x << ", " << b.center.y
       << "], \"box_px\": [" << std::max(b.size.width, b.size.height) << ", " << std::min(b.size.width, b.size.height)
       << "], \"angle_deg\": " << b.angle << ", \"area_px\": " << s.blob.pixels;
     if (r.bar.found) {
       o << ", \"length_mm\": " << s.length_mm << ", \"width_mm\": " << s.width_mm << ", \"area_mm2\": " << s.area_mm2;
     }
-    o << ", \"colour\": [" << s.colour[0] << ", " << s.colour[1] << ", " << s.colour[2] << "]}";
+    o << ", \"colour\": [" << s.colour[0] << ", " << s.colour[1] << ", " << s.colour[2] << "], \"flags\": [";
+    const std::vector<std::string> f = flagNames(s.flags);
+    for (size_t k = 0; k < f.size(); ++k) o << (k ? ", " : "") << "\"" << f[k] << "\"";
+    o << "]}";
   }
   o << "\n  ]\n}\n";
   return o.str();
+}
+
+void table(const PhotoResult& r, std::ostream& o) {
+  const bool mm = r.bar.found;
+  char line[256];
+  std::snprintf(line, sizeof(line), "%4s %10s %10s %11s  %s\n", "id", mm ? "length mm" : "length px",
+                mm ? "width mm" : "width px", mm ? "area mm2" : "area px2", "flags");
+  o << line;
+  for (size_t i = 0; i < r.sherds.size(); ++i) {
+    const PhotoSherd& s = r.sherds[i];
+    const double l = mm ? s.length_mm : std::max(s.blob.box.size.width, s.blob.box.size.height);
+    const double w = mm ? s.width_mm : std::min(s.blob.box.size.width, s.blob.box.size.height);
+    const double a = mm ? s.area_mm2 : s.blob.pixels;
+    std::string flags;
+    for (const std::string& f : flagNames(s.flags & ~static_cast<unsigned>(kNoScale))) flags += (flags.empty() ? "" : ",") + f;
+    std::snprintf(line, sizeof(line), "%4zu %10.1f %10.1f %11.0f  %s\n", i + 1, l, w, a, flags.c_str());
+    o << line;
+  }
 }
 
 cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
@@ -67,26 +148,21 @@ cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
   const int t = std::max(1, rgb.cols / 500);
   for (size_t i = 0; i < r.sherds.size(); ++i) {
     const PhotoSherd& s = r.sherds[i];
-    cv::drawContours(out, std::vector<std::vector<cv::Point>>{s.blob.contour}, 0, cv::Scalar(255, 255, 0), t);
-    cv::Point2f c[4];
-    s.blob.box.points(c);
-    for (int k = 0; k < 4; ++k) cv::line(out, c[k], c[(k + 1) % 4], cv::Scalar(0, 255, 0), t, cv::LINE_AA);
+    const bool flagged = (s.flags & ~static_cast<unsigned>(kNoScale)) != 0;
+    const cv::Scalar colour = flagged ? cv::Scalar(255, 140, 0) : cv::Scalar(0, 255, 255);
+    cv::drawContours(out, std::vector<std::vector<cv::Point>>{s.blob.contour}, 0, colour, t, cv::LINE_AA);
     char label[64];
-    if (r.bar.found) {
-      std::snprintf(label, sizeof(label), "%zu: %.0fx%.0f mm", i, s.length_mm, s.width_mm);
-    } else {
-      std::snprintf(label, sizeof(label), "%zu", i);
-    }
-    cv::putText(out, label, cv::Point(s.blob.bounds.x, s.blob.bounds.y - 4), cv::FONT_HERSHEY_SIMPLEX,
-                0.4 * t, cv::Scalar(255, 255, 0), t, cv::LINE_AA);
+    std::snprintf(label, sizeof(label), "%zu%s", i + 1, flagged ? "?" : "");
+    cv::putText(out, label, cv::Point(s.blob.bounds.x, std::max(10, s.blob.bounds.y - 4)), cv::FONT_HERSHEY_SIMPLEX,
+                0.45 * t, colour, t, cv::LINE_AA);
   }
   if (r.bar.found) {
     cv::Point2f c[4];
     r.bar.box.points(c);
     for (int k = 0; k < 4; ++k) cv::line(out, c[k], c[(k + 1) % 4], cv::Scalar(255, 0, 255), t, cv::LINE_AA);
     char label[64];
-    std::snprintf(label, sizeof(label), "scale bar: %.2f px/cm", r.bar.px_per_cm);
-    cv::putText(out, label, cv::Point(static_cast<int>(r.bar.box.center.x) - 60, static_cast<int>(r.bar.box.center.y) - 30),
+    std::snprintf(label, sizeof(label), "scale bar %.2f px/cm%s", r.bar.px_per_cm, r.bar.doubt.empty() ? "" : " ?");
+    cv::putText(out, label, cv::Point(static_cast<int>(r.bar.box.center.x) - 70, static_cast<int>(r.bar.box.center.y) - 25),
                 cv::FONT_HERSHEY_SIMPLEX, 0.5 * t, cv::Scalar(255, 0, 255), t, cv::LINE_AA);
   }
   return out;
@@ -94,56 +170,87 @@ cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) return usage();
-  if (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") return usage(stdout, 0);
-  std::string image = argv[1], background = "auto", json_path, png_path, mask_path;
+  static const option kLong[] = {{"json", required_argument, nullptr, 'j'},
+                                 {"overlay", required_argument, nullptr, 'o'},
+                                 {"no-overlay", no_argument, nullptr, 'n'},
+                                 {"mask", required_argument, nullptr, 'm'},
+                                 {"background", required_argument, nullptr, 'b'},
+                                 {"bar-length", required_argument, nullptr, 'l'},
+                                 {"clusters", required_argument, nullptr, 'k'},
+                                 {"help", no_argument, nullptr, 'h'},
+                                 {nullptr, 0, nullptr, 0}};
+  std::string json_path, overlay_path, mask_path, background;
+  bool overlay = true;
   PhotoSegmenter::Options options;
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) return usage();
-    const std::string v = argv[++i];
+  opterr = 0;  // our own one-line messages
+  int c;
+  while ((c = getopt_long(argc, argv, ":h", kLong, nullptr)) != -1) {
+    const std::string arg = optarg ? optarg : "";
     try {
-      if (a == "--background") {
-        background = v;
-      } else if (a == "--json") {
-        json_path = v;
-      } else if (a == "--png") {
-        png_path = v;
-      } else if (a == "--mask") {
-        mask_path = v;
-      } else if (a == "--bar-length") {
-        options.bar_length_cm = std::stod(v);
-      } else if (a == "--clusters") {
-        options.clusters = std::stoi(v);
-      } else {
-        return usage();
+      switch (c) {
+        case 'j': json_path = arg; break;
+        case 'o': overlay_path = arg; break;
+        case 'n': overlay = false; break;
+        case 'm': mask_path = arg; break;
+        case 'b': background = arg; break;
+        case 'l': {
+          size_t used = 0;
+          options.bar_length_cm = std::stod(arg, &used);
+          if (used != arg.size() || !(options.bar_length_cm > 0.5 && options.bar_length_cm < 100)) throw std::invalid_argument(arg);
+          break;
+        }
+        case 'k': {
+          size_t used = 0;
+          options.clusters = std::stoi(arg, &used);
+          if (used != arg.size() || options.clusters < 2 || options.clusters > 12) throw std::invalid_argument(arg);
+          break;
+        }
+        case 'h': std::fputs(kHelp, stdout); return 0;
+        case ':': return badUsage(std::string(argv[optind - 1]) + " needs a value");
+        default: return badUsage("unknown option " + std::string(argv[optind - 1]));
       }
     } catch (const std::exception&) {
-      std::fprintf(stderr, "segment_image: bad value '%s' for %s\n", v.c_str(), a.c_str());
-      return 2;
+      return badUsage("bad value '" + arg + "' for --" +
+                      (c == 'l' ? std::string("bar-length (a length in cm, e.g. 10)") : std::string("clusters (2..12)")));
     }
+  }
+  if (optind >= argc) return badUsage("no photo given");
+  if (argc - optind > 1) return badUsage("one photo at a time; got '" + std::string(argv[optind + 1]) + "' too");
+  const std::string image = argv[optind];
+  if (overlay && overlay_path.empty()) overlay_path = std::filesystem::path(image).stem().string() + "_segmented.jpg";
+  cv::setNumThreads(1);
+  PhotoResult r;
+  cv::Mat rgb;
+  try {
+    rgb = readRgb(image, "photo");
+    const cv::Mat bg = background.empty() ? cv::Mat() : readRgb(background, "--background");
+    r = PhotoSegmenter(options).segment(rgb, bg);
+  } catch (const std::exception& e) {
+    return badUsage(e.what());
   }
   try {
-    const cv::Mat rgb = readRgb(image);
-    const cv::Mat bg = background == "auto" ? cv::Mat() : readRgb(background);
-    const PhotoResult r = PhotoSegmenter(options).segment(rgb, bg);
-    const std::string text = json(image, rgb, r);
-    if (json_path.empty()) {
-      std::cout << text;
+    if (json_path == "-") {
+      std::cout << json(image, rgb, r);
     } else {
-      std::ofstream(json_path) << text;
+      if (!json_path.empty()) {
+        std::ofstream f(json_path);
+        if (!(f << json(image, rgb, r))) throw std::runtime_error("cannot write --json " + json_path);
+      }
+      table(r, std::cout);
     }
-    if (!mask_path.empty() && !cv::imwrite(mask_path, r.foreground)) throw std::runtime_error("cannot write " + mask_path);
-    if (!png_path.empty()) {
+    if (!mask_path.empty() && !cv::imwrite(mask_path, r.foreground)) throw std::runtime_error("cannot write --mask " + mask_path);
+    if (overlay) {
       cv::Mat bgr;
       cv::cvtColor(annotate(rgb, r), bgr, cv::COLOR_RGB2BGR);
-      if (!cv::imwrite(png_path, bgr)) throw std::runtime_error("cannot write " + png_path);
+      if (!cv::imwrite(overlay_path, bgr)) throw std::runtime_error("cannot write --overlay " + overlay_path);
     }
-    std::fprintf(stderr, "segment_image: %zu sherds, scale bar %s\n", r.sherds.size(),
-                 r.bar.found ? (std::to_string(r.bar.px_per_cm) + " px/cm").c_str() : "not found");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "segment_image: %s\n", e.what());
-    return 1;
+    return badUsage(e.what());
   }
-  return 0;
+  const std::vector<std::string> d = doubts(r);
+  std::string summary = std::to_string(r.sherds.size()) + " sherds, ";
+  summary += r.bar.found ? cv::format("scale bar %.2f px/cm", r.bar.px_per_cm) : std::string("no scale bar");
+  for (const std::string& x : d) summary += "; " + x;
+  std::fprintf(stderr, "segment_image: %s%s\n", summary.c_str(), d.empty() ? "" : " (doubtful: exit 1)");
+  return d.empty() ? kConfident : kDoubtful;
 }
