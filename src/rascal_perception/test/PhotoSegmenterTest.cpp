@@ -49,15 +49,14 @@ void check(const std::string& name, const std::vector<cv::Point2f>& centres) {
 // Photos whose count is still outside the hand range with the one set of defaults, and why.
 // The test reports them (count and range) but does not fail on them; the lead decides.
 const std::set<std::string> kKnownFailures = {
-    // Both are camera originals with the room around the black sheet (flagged
-    // background-doubtful). img129_orig: the pale floor has the buff sherds' colour and
-    // becomes a second background surface; a few sherds near it are lost or merged (about 117
-    // for 119-123; this count moved between 85 and 119 with small changes of the smoothing, so
-    // the photo sits on an edge of the method).
+    // Camera originals with the room around the black sheet (flagged background-doubtful):
+    // the floor, a chair and a bag beside the sheet are left out, but one count each stays
+    // just outside the hand range. img129_orig: among the crowded small sherds two merge (118
+    // for 119-123; the cropped img129 gives 120 of 119-121). img149_orig: a touching pair with
+    // a faint seam stays one (7 for 8-9; the cropped img149 gives 7 of 6-10). Which of these
+    // marginal photos passes has moved with every change to the cloth model: counted, not tuned.
     "img129SG101853_orig.jpg",
-    // img171_orig: a white bag, the chair frame and floor beside the sheet are counted (about
-    // 43 for 41).
-    "img171SG101906_orig.jpg",
+    "img149SG101882_orig.jpg",
 };
 }  // namespace
 
@@ -162,4 +161,40 @@ TEST(PhotoSegmenter, PhotoOfTheEmptyBackground) {
   const PhotoResult r = segmenter.segment(img, empty);
   ASSERT_EQ(r.sherds.size(), 1u);
   EXPECT_NEAR(r.sherds[0].blob.box.center.x, 280, 3);
+}
+
+TEST(PhotoSegmenter, ObjectsBesideTheClothAreLeftOut) {
+  // a dark sheet on a sandy floor (the floor fills the rim), buff sherds of nearly the floor's
+  // colour on the sheet, and two pale things on the floor beside it
+  cv::Mat img(600, 800, CV_8UC3, cv::Scalar(190, 150, 105));
+  cv::Mat noise(img.size(), CV_8UC3);
+  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(4));
+  const cv::Rect sheet(90, 70, 620, 460);
+  cv::rectangle(img, sheet, cv::Scalar(45, 45, 50), cv::FILLED);
+  // most of them near the sheet's edge, where the floor's smooth estimate reaches
+  const std::vector<cv::Point> on_sheet = {{145, 115}, {400, 112}, {655, 125}, {140, 480}, {400, 300}, {650, 485}};
+  for (const cv::Point& p : on_sheet) cv::ellipse(img, p, cv::Size(38, 26), 20.0, 0, 360, cv::Scalar(200, 160, 115), cv::FILLED);
+  cv::circle(img, cv::Point(40, 300), 25, cv::Scalar(235, 235, 235), cv::FILLED);  // a bag beside the sheet
+  cv::circle(img, cv::Point(760, 560), 20, cv::Scalar(230, 225, 220), cv::FILLED);
+  img += noise;
+  const PhotoResult r = PhotoSegmenter(PhotoSegmenter::Options()).segment(img);
+  EXPECT_FALSE(r.background_trusted);
+  ASSERT_FALSE(r.cloth_outline.empty());
+  EXPECT_GE(cv::pointPolygonTest(r.cloth_outline, cv::Point2f(400, 300), false), 0);
+  ASSERT_EQ(r.sherds.size(), on_sheet.size());
+  for (const PhotoSherd& s : r.sherds) EXPECT_TRUE(sheet.contains(s.blob.box.center)) << s.blob.box.center;
+  bool told = false;
+  for (const std::string& w : r.warnings) told = told || w.find("beside the cloth") != std::string::npos;
+  EXPECT_TRUE(told);
+}
+
+TEST(PhotoSegmenter, AnUnevenlyLitClothIsNotCutToAnOutline) {
+  // the cloth fills the photo, lit unevenly (a brighter half of the same chromaticity)
+  cv::Mat img(400, 600, CV_8UC3, cv::Scalar(45, 45, 50));
+  cv::rectangle(img, cv::Rect(300, 0, 300, 400), cv::Scalar(80, 80, 88), cv::FILLED);
+  cv::circle(img, cv::Point(150, 200), 40, cv::Scalar(200, 160, 115), cv::FILLED);
+  cv::circle(img, cv::Point(450, 200), 40, cv::Scalar(200, 160, 115), cv::FILLED);
+  const PhotoResult r = PhotoSegmenter(PhotoSegmenter::Options()).segment(img);
+  EXPECT_TRUE(r.cloth_outline.empty());
+  EXPECT_EQ(r.sherds.size(), 2u);
 }

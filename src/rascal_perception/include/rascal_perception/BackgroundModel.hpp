@@ -40,6 +40,10 @@ class BackgroundModel {
   /// 255 where the HSV image (COLOR_RGB2HSV_FULL) is background. `allowed` (CV_8U, one bit per
   /// cluster, 0xFF = any) restricts which clusters count at each pixel; empty = any everywhere.
   void classify(const cv::Mat& hsv, const cv::Mat& allowed, cv::Mat& background) const;
+  /// The same from the RGB image directly, through a table on RGB quantised to 6 bits per
+  /// channel (the camera-rate path: no HSV image; hue and saturation of the bin's centre, the
+  /// darkness test exact). Agrees with classify() except within one bin of a band's edge.
+  void classifyRgb(const cv::Mat& rgb, const cv::Mat& allowed, cv::Mat& background) const;
   /// Bits of the clusters that match (hue, saturation) in 8-bit HSV_FULL units.
   uint8_t match(uint8_t hue, uint8_t saturation) const { return lut_[hue * 256 + saturation]; }
 
@@ -57,6 +61,7 @@ class BackgroundModel {
   BackgroundOptions options_;
   std::vector<BackgroundCluster> clusters_;
   std::vector<uint8_t> lut_;  ///< 256 x 256 (hue, saturation) -> cluster bits
+  std::vector<uint8_t> rgb_lut_;  ///< 64 x 64 x 64 (R, G, B >> 2) -> cluster bits
   cv::Mat seen_, fixture_;
 };
 

@@ -35,6 +35,10 @@ struct PhotoResult {
   std::vector<PhotoSherd> sherds;
   cv::Mat foreground;
   bool background_trusted = true;     ///< false: the background model is doubtful
+  /// The cloth's outline (convex, full-resolution pixels) where the photo shows other surfaces
+  /// around it (floor, table, chair): sherds lie on the cloth, so blobs outside are left out.
+  /// Empty when the cloth fills the photo or an empty-background photo was given.
+  std::vector<cv::Point> cloth_outline;
   std::vector<std::string> warnings;  ///< photo-wide doubts, one line each
 };
 

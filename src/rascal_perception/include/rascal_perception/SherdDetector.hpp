@@ -64,6 +64,11 @@ class SherdDetector {
   GraspPlanner planner_;
   cv::Mat ray_z_;
   Eigen::Matrix3d ray_z_rotation_ = Eigen::Matrix3d::Zero();
+  /// per pixel the deepest reading [mm] that is still min_sherd_height above the surface, for
+  /// the camera height it was made for (a comparison per pixel instead of a ray per pixel)
+  cv::Mat raised_below_;
+  float raised_cam_z_ = -1.0f;
+  bool ray_z_rotation_changed_ = true;
   cv::Mat allowed_, fixture_, usable_;
 };
 

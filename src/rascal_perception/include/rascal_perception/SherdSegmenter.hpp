@@ -39,7 +39,7 @@ class SherdSegmenter {
   static Blob blobOf(const cv::Mat& part, const cv::Point& offset);
 
  private:
-  mutable cv::Mat hsv_, background_;
+  mutable cv::Mat background_;
 };
 
 }  // namespace rascal_perception

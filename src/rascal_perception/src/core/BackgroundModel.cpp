@@ -163,6 +163,20 @@ void BackgroundModel::buildLut() {
       lut_[h * 256 + s] = bits;
     }
   }
+  // every 6-bit RGB bin's centre through OpenCV's own HSV conversion, then the table above
+  cv::Mat centres(64 * 64, 64, CV_8UC3), hsv;
+  for (int r = 0; r < 64; ++r) {
+    for (int g = 0; g < 64; ++g) {
+      cv::Vec3b* row = centres.ptr<cv::Vec3b>(r * 64 + g);
+      for (int b = 0; b < 64; ++b) row[b] = cv::Vec3b(static_cast<uint8_t>(4 * r + 2), static_cast<uint8_t>(4 * g + 2), static_cast<uint8_t>(4 * b + 2));
+    }
+  }
+  cv::cvtColor(centres, hsv, cv::COLOR_RGB2HSV_FULL);
+  rgb_lut_.resize(64 * 64 * 64);
+  for (int i = 0; i < 64 * 64; ++i) {
+    const cv::Vec3b* p = hsv.ptr<cv::Vec3b>(i);
+    for (int b = 0; b < 64; ++b) rgb_lut_[i * 64 + b] = match(p[b][0], p[b][1]);
+  }
 }
 
 void BackgroundModel::classify(const cv::Mat& hsv, const cv::Mat& allowed, cv::Mat& background) const {
@@ -181,6 +195,24 @@ void BackgroundModel::classify(const cv::Mat& hsv, const cv::Mat& allowed, cv::M
       }
       const uint8_t bits = lut_[p[x][0] * 256 + p[x][1]];
       o[x] = (any ? bits : (bits & a[x])) ? 255 : 0;
+    }
+  }
+}
+
+void BackgroundModel::classifyRgb(const cv::Mat& rgb, const cv::Mat& allowed, cv::Mat& background) const {
+  if (!ready()) throw std::logic_error("BackgroundModel::classifyRgb: no model learnt");
+  const int vmin = static_cast<int>(std::lround(options_.min_value * 255.0));
+  background.create(rgb.size(), CV_8U);
+  const uint8_t* lut = rgb_lut_.data();
+  const cv::Mat everywhere = allowed.empty() ? cv::Mat(rgb.size(), CV_8U, cv::Scalar(0xFF)) : allowed;
+  for (int y = 0; y < rgb.rows; ++y) {
+    const uint8_t* p = rgb.ptr<uint8_t>(y);
+    const uint8_t* a = everywhere.ptr<uint8_t>(y);
+    uint8_t* o = background.ptr<uint8_t>(y);
+    for (int x = 0; x < rgb.cols; ++x, p += 3) {
+      const int r = p[0], g = p[1], b = p[2];
+      const bool dark = r < vmin && g < vmin && b < vmin;
+      o[x] = (dark || (lut[((r >> 2) << 12) | ((g >> 2) << 6) | (b >> 2)] & a[x])) ? 255 : 0;
     }
   }
 }

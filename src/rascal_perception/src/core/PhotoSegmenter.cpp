@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <opencv2/imgproc.hpp>
 
@@ -22,6 +23,16 @@ std::vector<std::string> flagNames(unsigned flags) {
 
 namespace {
 constexpr int kWorkSide = 640;  // [px] contrast resolution, see contrast()
+constexpr double kCoarseCells = 160.0;  // cells along the longer side of the background grid
+constexpr double kOutlineCells = 1.5;   // a blob centred closer to the cloth's outline is off it
+constexpr double kSheetSolidity = 0.9;  // a cloth's region fills at least this much of its hull
+// [CIELab a*b* units] two surfaces whose mean chromaticities differ by more are two materials
+// (a dark cloth on a sandy floor: 24-26 in the three photos that show one), not one cloth in
+// two lights (at most 5 where k-means split a cloth by its shading)
+constexpr double kOtherMaterialChroma = 12.0;
+
+/// a*b* distance of two mean colours of OpenCV's 8-bit Lab (a*, b* offset by 128; unit 1).
+double chromaDistance(const cv::Scalar& x, const cv::Scalar& y) { return std::hypot(x[1] - y[1], x[2] - y[2]); }
 
 /// Median of |m| over the pixels where `where` is set (every `step`-th row and column).
 double medianAbs(const cv::Mat& m, const cv::Mat& where, int step) {
@@ -42,22 +53,81 @@ double medianAbs(const cv::Mat& m, const cv::Mat& where, int step) {
 /// distance to the cloth's a*b* as a shadow would show it: a shadow dims the light, which
 /// shrinks a*b* towards grey with L*, so the cloth's a*b* is scaled by min(1, L / L_bg) first.
 void differences(const cv::Mat& lab, const cv::Mat& bg, cv::Mat& dl, cv::Mat& dab) {
-  std::vector<cv::Mat> p, b;
-  cv::split(lab, p);
-  cv::split(bg, b);
-  dl = p[0] - b[0];
-  cv::Mat dim;
-  cv::divide(p[0], cv::max(b[0], 1.0), dim);
-  dim = cv::min(dim, 1.0);
-  cv::Mat da = p[1] - 128.0f - (b[1] - 128.0f).mul(dim), db = p[2] - 128.0f - (b[2] - 128.0f).mul(dim);
-  cv::magnitude(da, db, dab);
-  // and a*b* of a dim pixel is noise (camera noise and JPEG over a few grey levels): weigh
-  // its distance by how much light it got, so deep shadows do not look coloured
-  dab = dab.mul(dim);
+  // one pass over the pixels: this runs at the working resolution for every surface, and a
+  // chain of whole-image OpenCV operations on float images cost three times as much
+  CV_Assert(lab.type() == CV_32FC3 && bg.type() == CV_32FC3 && lab.size() == bg.size());
+  dl.create(lab.size(), CV_32F);
+  dab.create(lab.size(), CV_32F);
+  for (int y = 0; y < lab.rows; ++y) {
+    const cv::Vec3f* p = lab.ptr<cv::Vec3f>(y);
+    const cv::Vec3f* b = bg.ptr<cv::Vec3f>(y);
+    float* l = dl.ptr<float>(y);
+    float* c = dab.ptr<float>(y);
+    for (int x = 0; x < lab.cols; ++x) {
+      l[x] = p[x][0] - b[x][0];
+      const float dim = std::min(p[x][0] / std::max(b[x][0], 1.0f), 1.0f);
+      const float da = p[x][1] - 128.0f - (b[x][1] - 128.0f) * dim;
+      const float db = p[x][2] - 128.0f - (b[x][2] - 128.0f) * dim;
+      // and a*b* of a dim pixel is noise (camera noise and JPEG over a few grey levels):
+      // weigh its distance by how much light it got, so deep shadows do not look coloured
+      c[x] = std::sqrt(da * da + db * db) * dim;
+    }
+  }
+}
+
+/// Contrast of each pixel to one surface, in units of that surface's spread (`sl` for L*,
+/// `sab` for a*b*): lighter than the surface, or another chromaticity. Darker with the
+/// surface's (dimmed) chromaticity is a shadow, so darker counts only where the chromaticity
+/// also differs (dark paint, brown clay on grey cloth).
+cv::Mat surfaceScore(const cv::Mat& dl, const cv::Mat& dab, double sl, double sab) {
+  cv::Mat score(dl.size(), CV_32F);
+  const float il = static_cast<float>(1.0 / sl), iab = static_cast<float>(1.0 / sab);
+  for (int y = 0; y < dl.rows; ++y) {
+    const float* l = dl.ptr<float>(y);
+    const float* c = dab.ptr<float>(y);
+    float* o = score.ptr<float>(y);
+    for (int x = 0; x < dl.cols; ++x) {
+      const float lighter = l[x] * il, colour = c[x] * iab;
+      const float darker = colour < 2.0f ? 0.0f : -lighter;
+      o[x] = std::max(std::max(lighter, colour), darker);
+    }
+  }
+  return score;
 }
 }  // namespace
 
 namespace {
+/// The cloth's outline on the coarse grid: the convex hull of the largest connected piece of
+/// its region (holes filled) once thin links are opened away: a chair's frame or a strip of
+/// the same colour touching its edge is not part of the sheet. A cloth is one convex sheet, so
+/// the opening grows until the piece fills its hull; empty if it never does (no outline is
+/// better than a wrong one).
+std::vector<cv::Point> clothHull(const cv::Mat& cloth_region) {
+  // every hole filled first: a shadow or a hotspot across the sheet is a hole in the cloth's
+  // colour, not in the sheet, and the sherds around it would leave only thin links to open
+  std::vector<std::vector<cv::Point>> pieces;
+  cv::findContours(cloth_region.clone(), pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  cv::Mat solid = cv::Mat::zeros(cloth_region.size(), CV_8U);
+  cv::drawContours(solid, pieces, -1, cv::Scalar(255), cv::FILLED);
+  for (const int k : {5, 9, 13, 17}) {
+    cv::Mat body, cc, stats, centroids;
+    cv::morphologyEx(solid, body, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+    const int n = cv::connectedComponentsWithStats(body, cc, stats, centroids, 4, CV_32S);
+    int best = 0;
+    for (int i = 1; i < n; ++i) {
+      if (best == 0 || stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = i;
+    }
+    if (best == 0) return {};
+    std::vector<std::vector<cv::Point>> outlines;
+    cv::findContours(cc == best, outlines, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+    if (outlines.empty()) return {};
+    std::vector<cv::Point> hull;
+    cv::convexHull(outlines.front(), hull);
+    if (stats.at<int>(best, cv::CC_STAT_AREA) >= kSheetSolidity * cv::contourArea(hull)) return hull;
+  }
+  return {};
+}
+
 /// A Gaussian blur of standard deviation `sigma` approximated by three box filters: the same
 /// smoothing at a cost independent of sigma (the background's sigma is 20 cells).
 void smooth(const cv::Mat& in, cv::Mat& out, double sigma) {
@@ -70,9 +140,9 @@ void smooth(const cv::Mat& in, cv::Mat& out, double sigma) {
 /// A smooth background from the pixels of `small` where `near` is set, refined `rounds` times
 /// from the pixels close to its own estimate (so it follows uneven light): normalised
 /// convolution, so sherds leave holes that their surroundings fill in. `support`: how much of
-/// the surface lies around each cell (0 far from it).
+/// the surface lies around each cell (0 far from it); `region`: the cells it covers, holes filled.
 void smoothBackground(const cv::Mat& small, cv::Mat& near, int rounds, double reach, const cv::Mat& spread_over,
-                      double min_piece, cv::Mat& bg, cv::Mat& support) {
+                      double min_piece, cv::Mat& bg, cv::Mat& support, cv::Mat* region = nullptr) {
   const double sigma = std::max(small.cols, small.rows) / 8.0;
   for (int it = 0; it < rounds; ++it) {
     cv::erode(near, near, cv::Mat());
@@ -109,6 +179,7 @@ void smoothBackground(const cv::Mat& small, cv::Mat& near, int rounds, double re
   }
   filled.convertTo(w, CV_32F, 1.0 / 255.0);
   smooth(w, support, sigma / 4);
+  if (region) *region = filled;
 }
 }  // namespace
 
@@ -127,7 +198,7 @@ cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background,
   lab.convertTo(lab, CV_32F);
   // The background on a coarse grid (about 160 cells across): cheap, and sherds smaller than
   // the smoothing scale do not pull it.
-  const int f = std::max(1, cvRound(std::max(rgb.cols, rgb.rows) / 160.0));
+  const int f = std::max(1, cvRound(std::max(rgb.cols, rgb.rows) / kCoarseCells));
   const cv::Size coarse(std::max(1, rgb.cols / f), std::max(1, rgb.rows / f));
   cv::Mat small;
   cv::resize(lab, small, coarse, 0, 0, cv::INTER_AREA);
@@ -153,9 +224,32 @@ cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background,
                cv::KMEANS_PP_CENTERS, centres);
     cv::theRNG().state = saved_rng;
     labels = labels.reshape(1, coarse.height);
+    // the cloth is the colour of the largest connected piece, its cells counted with less
+    // weight towards the rim: a photo is framed on the cloth, sherds of the table's colour are
+    // many small pieces, and a table around a mat is at the rim
+    cv::Mat weight(coarse, CV_64F);
+    for (int y = 0; y < coarse.height; ++y) {
+      const double v = (y + 0.5) / coarse.height * 2.0 - 1.0;
+      for (int x = 0; x < coarse.width; ++x) {
+        const double u = (x + 0.5) / coarse.width * 2.0 - 1.0;
+        weight.at<double>(y, x) = std::max(0.0, 1.0 - 0.5 * (u * u + v * v));
+      }
+    }
     int largest = 0;
-    for (int c = 1; c < k; ++c) {
-      if (cv::countNonZero(labels == c) > cv::countNonZero(labels == largest)) largest = c;
+    double most_present = -1.0;
+    for (int c = 0; c < k; ++c) {
+      cv::Mat cc;
+      const int n = cv::connectedComponents(labels == c, cc, 4, CV_32S);
+      std::vector<double> presence(n, 0.0);
+      for (int y = 0; y < coarse.height; ++y) {
+        for (int x = 0; x < coarse.width; ++x) presence[cc.at<int>(y, x)] += weight.at<double>(y, x);
+      }
+      for (int i = 1; i < n; ++i) {
+        if (presence[i] > most_present) {
+          most_present = presence[i];
+          largest = c;
+        }
+      }
     }
     // one large connected piece of another colour, larger than any sherd, is a second
     // surface (a mat on a table): sherds are many pieces, a surface is one
@@ -172,9 +266,9 @@ cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background,
     const bool two_surfaces = std::any_of(pieces.begin(), pieces.end(), [](const cv::Mat& p) { return !p.empty(); });
     // the cloth's spread over the whole photo (loose while the estimate is still rough),
     // unless the photo is two surfaces, whose spread together says nothing of either
-    cv::Mat bg, support, near = labels == largest;
+    cv::Mat bg, support, cloth_region, near = labels == largest;
     smoothBackground(small, near, 3, 2.5, two_surfaces ? near.clone() : cv::Mat(coarse, CV_8U, cv::Scalar(1)),
-                     options_.surface_fraction / 3, bg, support);
+                     options_.surface_fraction / 3, bg, support, &cloth_region);
     cv::resize(near, quiet_cloth, rgb.size(), 0, 0, cv::INTER_NEAREST);
     bgs.push_back(bg);
     supports.push_back(support);
@@ -200,18 +294,37 @@ cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background,
     // the rim is not cloth (the floor, a frame)
     const cv::Mat other = rim & ~cloth;
     const double rim_cells = cv::countNonZero(rim);
+    const std::vector<cv::Point> hull = clothHull(cloth_region);
+    cv::Mat sheet = cv::Mat::zeros(coarse, CV_8U);  // inside the outline, shadows included
+    if (hull.size() >= 3) cv::fillConvexPoly(sheet, hull, cv::Scalar(255));
+    bool around = false;  // some surface lies around the cloth rather than on it
+    const cv::Scalar cloth_colour = cv::mean(small, labels == largest);
     for (int c = 0; c < k; ++c) {
       if (c == largest) continue;
       const bool on_rim = on_cloth < 0.8 && cv::countNonZero(other & (labels == c)) > 0.1 * rim_cells;
       if (!on_rim && pieces[c].empty()) continue;
       cv::Mat bg2, support2, near2 = pieces[c].empty() ? cv::Mat((labels == c) & ~cloth) : pieces[c];
       // its spread over its own first pixels: the whole photo is mostly cloth
-      smoothBackground(small, near2, 2, 4.0, near2.clone(), options_.surface_fraction / 3, bg2, support2);
+      const cv::Mat first = near2.clone();
+      smoothBackground(small, near2, 2, 4.0, first, options_.surface_fraction / 3, bg2, support2);
+      // Where the rim is mostly not cloth, the cloth is a sheet inside the photo. A surface of
+      // another material on the rim (another chromaticity, not the cloth in other light: the
+      // floor, a table) lies around the sheet, not under anything inside it: a pale sherd the
+      // colour of the floor is still a sherd (where the cloth lies: its cells, holes filled).
+      if (on_rim && !r.background_trusted && hull.size() >= 3 &&
+          chromaDistance(cv::mean(small, first), cloth_colour) > kOtherMaterialChroma) {
+        support2.setTo(0, cloth_region | sheet);
+        around = true;
+      }
       bgs.push_back(bg2);
       supports.push_back(support2);
     }
+    if (around) {  // in the full photo's pixels
+      const double sx = static_cast<double>(full.cols) / coarse.width, sy = static_cast<double>(full.rows) / coarse.height;
+      for (const cv::Point& p : hull) r.cloth_outline.emplace_back(cvRound((p.x + 0.5) * sx), cvRound((p.y + 0.5) * sy));
+    }
   }
-  // per surface: lightness and shadow-aware chroma difference at full resolution; the unit
+  // per surface: lightness and shadow-aware chroma difference at working resolution; the unit
   // is that surface's own spread (texture, lint, noise) over the pixels close to it
   std::vector<cv::Mat> scores, full_supports;
   for (size_t i = 0; i < bgs.size(); ++i) {
@@ -222,12 +335,7 @@ cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background,
     const int step = std::max(1, static_cast<int>(std::sqrt(rgb.total() / 60000.0)));
     const double sl = std::max(options_.min_contrast_l, 1.4826 * medianAbs(dl, quiet, step));
     const double sab = std::max(options_.min_contrast_ab, 1.4826 * medianAbs(dab, quiet, step));
-    // Lighter than the surface, or another chromaticity. Darker with the surface's (dimmed)
-    // chromaticity is a shadow, so darker counts only where the chromaticity also differs
-    // (dark paint, brown clay on grey cloth).
-    cv::Mat lighter = dl / sl, colour = dab / sab, darker = -dl / sl;
-    darker.setTo(0, colour < 2.0);
-    cv::Mat s_i = cv::max(cv::max(lighter, colour), darker);
+    cv::Mat s_i = surfaceScore(dl, dab, sl, sab);
     cv::Mat support;
     cv::resize(supports[i], support, rgb.size(), 0, 0, cv::INTER_LINEAR);
     scores.push_back(s_i);
@@ -444,6 +552,29 @@ PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& backgroun
   cv::morphologyEx(fg, fg, cv::MORPH_OPEN,
                    cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(4 * radius + 1, 4 * radius + 1)));
   removeFrame(fg, r);
+  const double cell = longer / kCoarseCells;
+  // on the floor, a chair, a bag beside the cloth, or a sliver along its edge (the outline is
+  // known to about one coarse cell): left out before the costly splitting, and split parts below
+  auto off_sheet = [&](const cv::Point2f& centre) {
+    return !r.cloth_outline.empty() && cv::pointPolygonTest(r.cloth_outline, centre, true) < kOutlineCells * cell;
+  };
+  int off_cloth = 0;
+  if (!r.cloth_outline.empty()) {
+    cv::Mat cc, stats, centroids;
+    const int m = cv::connectedComponentsWithStats(fg, cc, stats, centroids, 8, CV_32S);
+    std::vector<uint8_t> on(m, 255);
+    on[0] = 0;
+    for (int i = 1; i < m; ++i) {
+      if (!off_sheet(cv::Point2f(static_cast<float>(centroids.at<double>(i, 0)), static_cast<float>(centroids.at<double>(i, 1))))) continue;
+      on[i] = 0;
+      off_cloth += stats.at<int>(i, cv::CC_STAT_AREA) >= min_side * min_side;  // specks are not objects
+    }
+    for (int y = 0; y < fg.rows; ++y) {
+      const int* l = cc.ptr<int>(y);
+      uint8_t* o = fg.ptr<uint8_t>(y);
+      for (int x = 0; x < fg.cols; ++x) o[x] = on[l[x]];
+    }
+  }
   std::vector<cv::Point2f> bar_corners;
   if (r.bar.found) {  // the bar and its card are not sherds
     cv::RotatedRect grown = r.bar.box;
@@ -475,6 +606,10 @@ PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& backgroun
   bool strip_warned = false;
   for (Blob& b : blobs) {
     if (!bar_corners.empty() && cv::pointPolygonTest(bar_corners, b.box.center, false) >= 0) continue;
+    if (off_sheet(b.box.center)) {
+      ++off_cloth;
+      continue;
+    }
     PhotoSherd s;
     const cv::Scalar c = cv::mean(rgb(b.bounds), b.mask);
     s.colour = cv::Vec3d(c[0], c[1], c[2]) / 255.0;
@@ -504,6 +639,10 @@ PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& backgroun
     if (clear < options_.low_contrast) s.flags |= kLowContrast;
     s.blob = std::move(b);
     r.sherds.push_back(std::move(s));
+  }
+  if (off_cloth > 0) {
+    r.warnings.emplace_back(std::to_string(off_cloth) + (off_cloth == 1 ? " object" : " objects") +
+                            " beside the cloth left out");
   }
   return r;
 }

@@ -36,20 +36,31 @@ cv::Mat SherdDetector::raised(const cv::Mat& depth_mm, const CameraView& view, d
   if ((ray_z_rotation_ - view.base_T_camera.linear()).norm() > 1e-9 || ray_z_.size() != depth_mm.size()) {
     ray_z_ = SherdMeasurer::rayZMap(view);
     ray_z_rotation_ = view.base_T_camera.linear();
+    ray_z_rotation_changed_ = true;
   }
   const float cam_z = static_cast<float>(view.base_T_camera.translation().z() - surface_z);
   const float min_h = static_cast<float>(config_.min_sherd_height);
+  if (raised_below_.size() != depth_mm.size() || raised_cam_z_ != cam_z || ray_z_rotation_changed_) {
+    // raised: cam_z + ray_z * depth > min_h; a ray looking down (ray_z < 0) meets that for
+    // depths below (min_h - cam_z) / ray_z, one looking up for any depth
+    raised_below_.create(depth_mm.size(), CV_16U);
+    for (int y = 0; y < depth_mm.rows; ++y) {
+      const float* r = ray_z_.ptr<float>(y);
+      uint16_t* o = raised_below_.ptr<uint16_t>(y);
+      for (int x = 0; x < depth_mm.cols; ++x) {
+        const float below = r[x] < 0.0f ? 1000.0f * (min_h - cam_z) / r[x] : 65535.0f;
+        o[x] = static_cast<uint16_t>(std::clamp(std::ceil(below), 0.0f, 65535.0f));  // integer d < below
+      }
+    }
+    raised_cam_z_ = cam_z;
+    ray_z_rotation_changed_ = false;
+  }
   const uint16_t lo = static_cast<uint16_t>(config_.depth_min * 1000.0);
   const uint16_t hi = static_cast<uint16_t>(std::min(65535.0, config_.depth_max * 1000.0));
-  cv::Mat out(depth_mm.size(), CV_8U);
-  for (int y = 0; y < depth_mm.rows; ++y) {
-    const uint16_t* d = depth_mm.ptr<uint16_t>(y);
-    const float* r = ray_z_.ptr<float>(y);
-    uint8_t* o = out.ptr<uint8_t>(y);
-    for (int x = 0; x < depth_mm.cols; ++x) {
-      o[x] = (d[x] >= lo && d[x] <= hi && cam_z + r[x] * (d[x] * 0.001f) > min_h) ? 255 : 0;
-    }
-  }
+  cv::Mat out, valid;
+  cv::compare(depth_mm, raised_below_, out, cv::CMP_LT);
+  cv::inRange(depth_mm, cv::Scalar(lo), cv::Scalar(hi), valid);
+  out &= valid;
   // a sherd is never thinner than a few pixels: drop isolated noise
   cv::morphologyEx(out, out, cv::MORPH_OPEN, cv::Mat::ones(3, 3, CV_8U));
   return out;

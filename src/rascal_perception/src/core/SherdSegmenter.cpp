@@ -11,8 +11,7 @@ std::vector<Blob> SherdSegmenter::segment(const cv::Mat& rgb, const BackgroundMo
                                           const cv::Mat& fixture, const cv::Mat& raised,
                                           const SegmentationOptions& options, cv::Mat& foreground,
                                           SegmentationStats* stats) const {
-  cv::cvtColor(rgb, hsv_, cv::COLOR_RGB2HSV_FULL);
-  model.classify(hsv_, allowed, background_);
+  model.classifyRgb(rgb, allowed, background_);
   cv::bitwise_not(background_, foreground);
   if (!raised.empty()) cv::bitwise_or(foreground, raised, foreground);
   if (!fixture.empty()) foreground.setTo(0, fixture);
@@ -22,16 +21,14 @@ std::vector<Blob> SherdSegmenter::segment(const cv::Mat& rgb, const BackgroundMo
   return blobs(foreground, options, stats);
 }
 
-Blob SherdSegmenter::blobOf(const cv::Mat& part, const cv::Point& offset) {
-  std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(part, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, offset);
+namespace {
+// A blob filling this much of its convex hull has no neck to split at (two touching sherds
+// leave a notch on each side: about 0.8-0.9).
+constexpr double kConvex = 0.95;
+
+Blob blobOfContour(const std::vector<cv::Point>& contour) {
   Blob b;
-  if (contours.empty()) return b;
-  size_t best = 0;
-  for (size_t i = 1; i < contours.size(); ++i) {
-    if (cv::contourArea(contours[i]) > cv::contourArea(contours[best])) best = i;
-  }
-  b.contour = std::move(contours[best]);
+  b.contour = contour;
   b.bounds = cv::boundingRect(b.contour);
   b.mask = cv::Mat::zeros(b.bounds.size(), CV_8U);
   cv::drawContours(b.mask, std::vector<std::vector<cv::Point>>{b.contour}, 0, cv::Scalar(255), cv::FILLED,
@@ -39,6 +36,18 @@ Blob SherdSegmenter::blobOf(const cv::Mat& part, const cv::Point& offset) {
   b.pixels = cv::countNonZero(b.mask);
   b.box = cv::minAreaRect(b.contour);
   return b;
+}
+}  // namespace
+
+Blob SherdSegmenter::blobOf(const cv::Mat& part, const cv::Point& offset) {
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(part, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, offset);
+  if (contours.empty()) return Blob();
+  size_t best = 0;
+  for (size_t i = 1; i < contours.size(); ++i) {
+    if (cv::contourArea(contours[i]) > cv::contourArea(contours[best])) best = i;
+  }
+  return blobOfContour(contours[best]);
 }
 
 std::vector<Blob> SherdSegmenter::blobs(const cv::Mat& mask, const SegmentationOptions& options,
@@ -57,20 +66,24 @@ std::vector<Blob> SherdSegmenter::blobs(const cv::Mat& mask, const SegmentationO
       ++st.rejected_border;
       continue;
     }
-    // a 1 px frame so the distance transform sees the blob's edge everywhere
-    const cv::Rect padded(r.x - 1, r.y - 1, r.width + 2, r.height + 2);
-    cv::Mat filled = cv::Mat::zeros(padded.size(), CV_8U);
-    cv::drawContours(filled, std::vector<std::vector<cv::Point>>{c}, 0, cv::Scalar(255), cv::FILLED, cv::LINE_8,
-                     cv::noArray(), 0, -padded.tl());
-    std::vector<cv::Mat> parts;
-    if (options.split) {
-      parts = split(filled, options.split_min_neck, 0.25 * options.min_side_px);
+    // Most blobs are one convex sherd: no neck to split at, and the contour is the blob's own
+    // (the camera-rate path spends most of its time below otherwise).
+    std::vector<Blob> found;
+    std::vector<cv::Point> hull;
+    cv::convexHull(c, hull);
+    if (!options.split || cv::contourArea(c) >= kConvex * cv::contourArea(hull)) {
+      found.push_back(blobOfContour(c));
     } else {
-      parts.push_back(filled);
+      // a 1 px frame so the distance transform sees the blob's edge everywhere
+      const cv::Rect padded(r.x - 1, r.y - 1, r.width + 2, r.height + 2);
+      cv::Mat filled = cv::Mat::zeros(padded.size(), CV_8U);
+      cv::drawContours(filled, std::vector<std::vector<cv::Point>>{c}, 0, cv::Scalar(255), cv::FILLED, cv::LINE_8,
+                       cv::noArray(), 0, -padded.tl());
+      const std::vector<cv::Mat> parts = split(filled, options.split_min_neck, 0.25 * options.min_side_px);
+      if (parts.size() > 1) st.splits += static_cast<int>(parts.size()) - 1;
+      for (const cv::Mat& p : parts) found.push_back(blobOf(p, padded.tl()));
     }
-    if (parts.size() > 1) st.splits += static_cast<int>(parts.size()) - 1;
-    for (const cv::Mat& p : parts) {
-      Blob b = blobOf(p, padded.tl());
+    for (Blob& b : found) {
       if (b.contour.empty()) continue;
       const double lo = std::min(b.box.size.width, b.box.size.height);
       const double hi = std::max(b.box.size.width, b.box.size.height);
@@ -124,13 +137,16 @@ std::vector<cv::Mat> SherdSegmenter::split(const cv::Mat& mask, double min_neck,
     while (group[i] != i) i = group[i] = group[group[i]];
     return i;
   };
+  // For a pair the threshold is set by the lower peak, so one labelling per peak at its own
+  // threshold decides all its pairs with higher peaks (one pass per peak, not per pair: a
+  // blob of many sherds has dozens of peaks).
   cv::Mat labels;
   for (size_t i = 0; i < peaks.size(); ++i) {
-    for (size_t j = i + 1; j < peaks.size(); ++j) {
-      if (root(static_cast<int>(i)) == root(static_cast<int>(j))) continue;
-      const float t = static_cast<float>(min_neck) * std::min(peaks[i].v, peaks[j].v);
-      cv::connectedComponents(dist >= t, labels, 8, CV_32S);
-      if (labels.at<int>(peaks[i].p) == labels.at<int>(peaks[j].p)) group[root(static_cast<int>(j))] = root(static_cast<int>(i));
+    cv::connectedComponents(dist >= static_cast<float>(min_neck) * peaks[i].v, labels, 8, CV_32S);
+    const int li = labels.at<int>(peaks[i].p);
+    for (size_t j = 0; j < peaks.size(); ++j) {
+      if (j == i || peaks[j].v < peaks[i].v || (peaks[j].v == peaks[i].v && j < i)) continue;
+      if (labels.at<int>(peaks[j].p) == li) group[root(static_cast<int>(j))] = root(static_cast<int>(i));
     }
   }
   std::vector<int> roots;

@@ -146,6 +146,10 @@ void table(const PhotoResult& r, std::ostream& o) {
 cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
   cv::Mat out = rgb.clone();
   const int t = std::max(1, rgb.cols / 500);
+  if (!r.cloth_outline.empty()) {  // where the cloth was taken to be: nothing outside is counted
+    cv::polylines(out, std::vector<std::vector<cv::Point>>{r.cloth_outline}, true, cv::Scalar(120, 255, 120), t,
+                  cv::LINE_AA);
+  }
   for (size_t i = 0; i < r.sherds.size(); ++i) {
     const PhotoSherd& s = r.sherds[i];
     const bool flagged = (s.flags & ~static_cast<unsigned>(kNoScale)) != 0;
