@@ -33,6 +33,8 @@ APT_PACKAGES=(
   postgresql-15 postgresql-client-15 python3-psycopg2
   # pictures of rviz without a screen
   xvfb xauth
+  # field rig drivers (rascal_drivers): the scale's serial line, the DSLR through libgphoto2
+  python3-serial python3-gphoto2
 )
 # dpkg-query answers in a fraction of a second, so the check runs every time; a package it has
 # never heard of prints nothing, which also counts as missing.
