@@ -8,7 +8,8 @@ import os
 from typing import List, Tuple
 
 from rascal_tasks.catalogue import ArchiveError, Catalogue, ImageArchive, repair_archive
-from rascal_tasks.catalogue.archive import owner_tag
+from rascal_tasks.catalogue.archive import make_dirs, owner_tag
+from rascal_tasks.catalogue.context_id import context_folder
 
 DEFAULT_MIN_FREE_MB = 1000  # archive.min_free_mb's default in the parameter schema
 UNSTABLE_NOTE = "scale reading not stable"  # the note of a sherd recorded mass_unstable
@@ -81,7 +82,7 @@ class Recorder:
         """Where the archival camera writes before the archive takes the file over."""
         spool = os.path.join(self.archive.root, ".spool")
         try:
-            os.makedirs(spool, exist_ok=True)
+            make_dirs(spool, self.archive.dir_mode)
         except OSError as e:
             raise ArchiveError(
                 "archive.root %s: cannot create %s (%s); make the folder writable"
@@ -89,7 +90,7 @@ class Recorder:
             ) from None
         # named for this catalogue too: two catalogues sharing an archive never share a capture
         tag = owner_tag(self.catalogue.identity())
-        return os.path.join(spool, "%s-%d-%s.png" % (self.context, seq, tag))
+        return os.path.join(spool, "%s-%d-%s.png" % (context_folder(self.context), seq, tag))
 
     def photo(self, seq, image_path: str, seconds: float = None) -> str:
         """Archive the captured file atomically, then record its path and SHA-256."""

@@ -19,6 +19,13 @@ import rospy
 
 from rascal_tasks import exit_codes
 from rascal_tasks.catalogue import Catalogue, ConnectionLostError, ImageArchive
+from rascal_tasks.catalogue.context_batches import (
+    START_RESUME,
+    ContextInUse,
+    context_state,
+    log_batch,
+    start_mode,
+)
 from rascal_tasks.catalogue.context_id import validate_context_id
 from rascal_tasks.catalogue.errors import CatalogueError
 from rascal_tasks.config import ConfigError, load_config
@@ -85,11 +92,12 @@ def _default_database(cfg):
     return cfg["database"]["dsn"], cfg["database"]["connect_timeout"], cfg.source
 
 
-def run(context: str, config_path: str = None, database=None) -> int:
+def run(context: str, config_path: str = None, database=None, append: bool = False) -> int:
     """One batch of `context`. `config_path`: a site config file to use instead of the parameter
     server's (checked against it); `database(cfg)` -> (dsn, connect_timeout, where it came
-    from), by default the config's. Returns an exit code of exit_codes.py."""
-    r = Run(context, config_path, database or _default_database)
+    from), by default the config's; `append` (--continue): a context whose last batch finished
+    complete takes a new bag (`context_batches`). Returns an exit code of exit_codes.py."""
+    r = Run(context, config_path, database or _default_database, append)
     try:
         return r.main()
     except KeyboardInterrupt:  # before the handlers are in place: nothing has moved
@@ -103,8 +111,10 @@ class _Interrupted(Exception):
 
 
 class Run:
-    def __init__(self, context, config_path, database):
+    def __init__(self, context, config_path, database, append=False):
         self.context = context
+        self.append = append
+        self.batch_logged = False  # batch_started written (once the context is open)
         self.config_path = config_path
         self.database = database
         self.cfg = None
@@ -121,7 +131,7 @@ class Run:
     # --- before anything moves ---
     def main(self) -> int:
         try:
-            validate_context_id(self.context)
+            self.context = validate_context_id(self.context)  # stored NFC-normalised
         except CatalogueError as e:
             return fail(str(e))
         if self.config_path:  # a broken file is said before anything else
@@ -173,6 +183,17 @@ class Run:
             return fail(str(e), exit_codes.BUSY)
         except psycopg2.Error as e:
             return fail("database: cannot lock the context: %s" % _first_line(e), exit_codes.FAULT)
+        try:  # under the context's lock: a new bag on a finished context needs --continue
+            state = context_state(self.catalogue.connection, self.context)
+            if start_mode(state, self.context, self.append) == START_RESUME:
+                print(
+                    "resuming context %s: %d sherds recorded, %d unfinished; its last run did "
+                    "not finish" % (self.context, state["sherds"], state["unfinished"])
+                )
+        except ContextInUse as e:
+            return fail(str(e))
+        except psycopg2.Error as e:
+            return fail("database: %s" % _first_line(e), exit_codes.FAULT)
         try:
             simulated = bool(rospy.get_param("/use_sim_time", False))
             if not wait_for_nodes(
@@ -187,7 +208,11 @@ class Run:
         except RigError as e:
             return fail(str(e), exit_codes.FAULT)
         try:
-            archive = ImageArchive(cfg.resolve(cfg["archive"]["root"]))
+            archive = ImageArchive(
+                cfg.resolve(cfg["archive"]["root"]),
+                file_mode=cfg["archive"]["file_mode"],
+                dir_mode=cfg["archive"]["dir_mode"],
+            )
         except (CatalogueError, OSError) as e:
             return fail("archive.root: %s" % _first_line(e), exit_codes.FAULT)
         return self.batches(archive)
@@ -233,6 +258,18 @@ class Run:
                 if code:
                     return code
                 continue
+            if not self.batch_logged:  # the context exists now (Recorder opened it)
+                try:
+                    log_batch(
+                        self.catalogue.connection,
+                        self.context,
+                        cfg["rig"]["name"],
+                        "batch_started",
+                        {"append": self.append},
+                    )
+                    self.batch_logged = True
+                except psycopg2.Error as e:
+                    rospy.logwarn("batch_started not logged: %s", _first_line(e))
             batch = Batch(
                 cfg, self.rig, recorder, self.context, progress=progress, log=rospy.loginfo
             )
@@ -266,7 +303,18 @@ class Run:
             self.stop_reason = self.stop_reason or "database: %s" % _first_line(e)
             outcome = "aborted"
         print_summary(done, rows, outcome, time.monotonic() - wall)
-        return self.exit_code(outcome, done[-1], rows)
+        code = self.exit_code(outcome, done[-1], rows)
+        try:  # exit 0 closes the context (a new bag then needs --continue)
+            log_batch(
+                self.catalogue.connection,
+                self.context,
+                cfg["rig"]["name"],
+                "batch_ended",
+                {"exit": code, "outcome": outcome},
+            )
+        except psycopg2.Error as e:  # not logged: the next run resumes, which loses nothing
+            rospy.logwarn("batch_ended not logged: %s", _first_line(e))
+        return code
 
     def exit_code(self, outcome, batch, rows) -> int:
         if outcome == "preempted":

@@ -1,15 +1,19 @@
 """``ImageArchive``: archival images on disk, written so that a crash never leaves a partial
 file under a final name.
 
-Layout: ``<root>/<context>/<seq>-<tag>.png`` with ``<seq>-<tag>.json`` beside it (the sherd's
-record, the image's SHA-256 and the writing catalogue's identity). ``<tag>`` is the first 12 hex
+Layout: ``<root>/<folder>/<seq>-<tag>.png`` with ``<seq>-<tag>.json`` beside it (the sherd's
+record, the image's SHA-256 and the writing catalogue's identity). ``<folder>`` is the context
+ID made safe as a file name (``context_id.context_folder``: ``TR1/1023`` is ``TR1%2F1023``; an
+ID of letters, digits, '-', '_', '.' is its own folder). ``<tag>`` is the first 12 hex
 digits of that identity (``Catalogue.identity``), so two catalogues recording the same context
 into one folder never overwrite each other. Rows written before the tag keep their
 ``<context>/<seq>.png``; the sidecar of any image is its path with ``.json`` for ``.png``.
 
 Each file is written to a temporary name in the same directory (``.<name>.<random>.tmp``),
 flushed and fsync'ed, then renamed into place (``os.replace`` is atomic on POSIX); the directory
-is fsync'ed after the rename. Only then are the path and hash handed to the database. A crash
+is fsync'ed after the rename. Files get ``file_mode`` (0644) and the folders the archive creates
+``dir_mode`` (0755) whatever the umask, so the group can read the archive (archive.file_mode,
+archive.dir_mode). Only then are the path and hash handed to the database. A crash
 can leave a temporary file behind (never a partial final file): ``repair_archive`` removes it.
 
 Every OS failure is an ``ArchiveError`` whose text is one line naming archive.root and the fix.
@@ -24,7 +28,7 @@ import re
 import tempfile
 import time
 
-from .context_id import validate_context_id
+from .context_id import context_folder, context_from_folder, validate_context_id
 from .errors import ArchiveError, ContextIdError, FieldError
 
 __all__ = [
@@ -34,6 +38,9 @@ __all__ = [
     "owner_tag",
     "sidecar_relpath",
     "sidecar_content",
+    "FILE_MODE",
+    "DIR_MODE",
+    "make_dirs",
 ]
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -44,6 +51,8 @@ _MB = 1000 * 1000
 ARCHIVE_NAME = re.compile(r"^(\d+)(?:-([0-9a-f]{%d}))?\.(png|json)$" % TAG_LENGTH)
 TEMP_NAME = re.compile(r"^\..+\.tmp$")
 _PROBE_PREFIX = ".rascal-probe-"
+FILE_MODE = 0o644  # archive.file_mode: readable by the group and others, written by the owner
+DIR_MODE = 0o755  # archive.dir_mode
 
 
 def _json_default(value):
@@ -87,11 +96,18 @@ def _user():
 class ImageArchive:
     """Stores images under ``root`` (created if missing; see ``check``)."""
 
-    def __init__(self, root, fsync=True):
+    def __init__(self, root, fsync=True, file_mode=FILE_MODE, dir_mode=DIR_MODE):
         if not isinstance(root, str) or not root:
             raise FieldError("archive.root %r: must be a directory path" % (root,))
+        for key, mode in (("archive.file_mode", file_mode), ("archive.dir_mode", dir_mode)):
+            if isinstance(mode, bool) or not isinstance(mode, int) or not 0 <= mode <= 0o777:
+                raise FieldError(
+                    "%s %r: must be permission bits 0000..0777, e.g. 0644 (octal)" % (key, mode)
+                )
         self.root = os.path.abspath(root)
         self._fsync = fsync
+        self.file_mode = file_mode
+        self.dir_mode = dir_mode
         self.min_free_bytes = 0  # set by check(); store() keeps to it
 
     # --- the folder itself ---
@@ -110,7 +126,7 @@ class ImageArchive:
                 "config/rascal.yaml to a folder" % self.root
             )
         try:
-            os.makedirs(self.root, exist_ok=True)
+            make_dirs(self.root, self.dir_mode)
         except OSError as e:
             raise ArchiveError(
                 "archive.root %s: does not exist and cannot be created (%s); create it "
@@ -158,16 +174,17 @@ class ImageArchive:
     # --- names ---
     @staticmethod
     def relpath(context_id, seq, owner=None):
-        """Where a sherd's image lives, relative to the root: ``<context>/<seq>-<tag>.png``
-        with the catalogue's identity ``owner``, ``<context>/<seq>.png`` without."""
-        validate_context_id(context_id)
+        """Where a sherd's image lives, relative to the root: ``<folder>/<seq>-<tag>.png``
+        with the catalogue's identity ``owner``, ``<folder>/<seq>.png`` without (``<folder>``:
+        ``context_folder(context_id)``)."""
+        folder = context_folder(context_id)
         if isinstance(seq, bool) or not isinstance(seq, int) or seq < 1:
             raise FieldError(
                 "seq %r: must be the sherd's sequence number (an integer >= 1)" % (seq,)
             )
         if owner is None:
-            return "%s/%d.png" % (context_id, seq)
-        return "%s/%d-%s.png" % (context_id, seq, owner_tag(owner))
+            return "%s/%d.png" % (folder, seq)
+        return "%s/%d-%s.png" % (folder, seq, owner_tag(owner))
 
     def path(self, relpath):
         """Absolute path of an archived file; refuses paths that leave the archive."""
@@ -245,26 +262,41 @@ class ImageArchive:
         return data
 
     def context_dirs(self):
-        """Names of the folders under the root that are context IDs."""
+        """The context IDs whose folders are under the root (a cut long name: the ID its
+        sidecars name)."""
         try:
             names = sorted(os.listdir(self.root))
         except FileNotFoundError:
             return []
         out = []
         for name in names:
-            try:
-                validate_context_id(name)
-            except ContextIdError:
+            if not os.path.isdir(os.path.join(self.root, name)):
                 continue
-            if os.path.isdir(os.path.join(self.root, name)):
-                out.append(name)
+            context = context_from_folder(name) or self._context_of_cut_folder(name)
+            if context is not None:
+                out.append(context)
         return out
+
+    def _context_of_cut_folder(self, name):
+        try:
+            sidecars = sorted(os.listdir(os.path.join(self.root, name)))
+        except OSError:
+            return None
+        for n in sidecars:
+            if ARCHIVE_NAME.match(n) and n.endswith(".json"):
+                try:
+                    side = self.read_sidecar("%s/%s" % (name, n[:-5] + ".png"))
+                    context = validate_context_id((side or {}).get("context_id"))
+                except (ValueError, ContextIdError):
+                    continue
+                if context_folder(context) == name:
+                    return context
+        return None
 
     def files(self, context_id):
         """Names of the plain files directly in a context's folder (subfolders, such as the
         report, are not the archive's)."""
-        validate_context_id(context_id)
-        folder = os.path.join(self.root, context_id)
+        folder = os.path.join(self.root, context_folder(context_id))
         try:
             names = sorted(os.listdir(folder))
         except FileNotFoundError:
@@ -277,7 +309,12 @@ class ImageArchive:
         modified more than ``older_than`` seconds before ``now``: younger ones may belong to
         a write in progress."""
         contexts = [context_id] if context_id is not None else self.context_dirs()
-        found = ["%s/%s" % (c, n) for c in contexts for n in self.files(c) if TEMP_NAME.match(n)]
+        found = [
+            "%s/%s" % (context_folder(c), n)
+            for c in contexts
+            for n in self.files(c)
+            if TEMP_NAME.match(n)
+        ]
         try:
             found += [
                 n
@@ -325,7 +362,7 @@ class ImageArchive:
 
     def _makedirs(self, directory):
         try:
-            os.makedirs(directory, exist_ok=True)
+            make_dirs(directory, self.dir_mode)
         except OSError as e:
             raise self._write_error(directory, e) from None
 
@@ -384,6 +421,7 @@ class ImageArchive:
                 if check_png and total == 0:
                     raise FieldError("image: empty (the capture returned no data)")
                 f.flush()
+                os.fchmod(f.fileno(), self.file_mode)  # mkstemp made it 0600
                 if self._fsync:
                     os.fsync(f.fileno())
             os.replace(tmp, final)
@@ -402,3 +440,24 @@ class ImageArchive:
                 raise self._write_error(final, e) from None
             raise
         return h.hexdigest()
+
+
+def make_dirs(directory, mode=DIR_MODE):
+    """``os.makedirs`` whose new folders get exactly ``mode`` (not mode & ~umask); folders that
+    already exist keep theirs."""
+    directory = os.path.abspath(directory)
+    missing = []
+    while not os.path.isdir(directory):
+        missing.append(directory)
+        parent = os.path.dirname(directory)
+        if parent == directory:
+            break
+        directory = parent
+    for d in reversed(missing):
+        try:
+            os.mkdir(d, mode)
+        except FileExistsError:
+            if not os.path.isdir(d):
+                raise
+            continue
+        os.chmod(d, mode)

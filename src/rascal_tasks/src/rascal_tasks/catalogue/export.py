@@ -1,7 +1,8 @@
 """Export of a context's sherds as CSV or JSON, in the column order of ``fields.COLUMNS``.
 
-CSV: a header row, then one row per sherd; floats are written with Python's shortest
-round-trip representation, timestamps as ISO 8601 in UTC, a missing value as an empty cell.
+CSV: a header row, then one row per sherd; floats rounded to the precision they were measured
+to (``PRECISION``: 0.1 g, 0.1 mm, …) and written with Python's shortest representation,
+timestamps as ISO 8601 in UTC, a missing value as an empty cell. JSON rounds the same way.
 JSON: ``{"format", "version", "context": {...}, "columns": [...], "sherds": [{...}]}`` with
 numbers as numbers and missing values as null. ``parse_csv`` reads the CSV back into the
 same Python values (the round trip the tests check).
@@ -9,6 +10,7 @@ same Python values (the round trip the tests check).
 
 import csv
 import datetime
+import decimal
 import io
 import json
 
@@ -16,10 +18,50 @@ from .context_id import validate_context_id
 from .errors import FieldError
 from .fields import COLUMN_TYPES, COLUMNS
 
-__all__ = ["EXPORT_FORMAT", "export_records", "to_csv", "to_json", "parse_csv", "json_default"]
+__all__ = [
+    "EXPORT_FORMAT",
+    "PRECISION",
+    "export_records",
+    "rounded",
+    "to_csv",
+    "to_json",
+    "parse_csv",
+    "json_default",
+]
 
 EXPORT_FORMAT = "rascal-catalogue-export"
 EXPORT_VERSION = 1
+
+# Decimal places a float column is exported with: what the rig resolves, not the 14 digits of
+# a double (scale 0.1 g; outline 0.1 mm; L*a*b* 0.1; pickup 0.1 mm; times 0.1 s).
+PRECISION = {
+    "mass_g": 1,
+    "length_mm": 1,
+    "width_mm": 1,
+    "thickness_mm": 1,
+    "colour_l": 1,
+    "colour_a": 1,
+    "colour_b": 1,
+    "chart_delta_e00": 2,
+    "px_per_cm": 1,
+    "pickup_x_m": 4,
+    "pickup_y_m": 4,
+}
+_TIME_PLACES = 1  # every t_*_s column
+
+
+def rounded(name, value):
+    """``value`` of float column ``name`` rounded to its exported precision (None stays)."""
+    if value is None:
+        return None
+    places = PRECISION.get(name, _TIME_PLACES if name.startswith("t_") else None)
+    if places is None:
+        return float(value)
+    # half up on the decimal a person reads (30.25 mm is 30.3, as on paper), not half-even
+    # on the binary double (round(30.25, 1) is 30.2)
+    exact = decimal.Decimal(repr(float(value)))
+    return float(exact.quantize(decimal.Decimal(1).scaleb(-places), decimal.ROUND_HALF_UP))
+
 
 _SELECT = (
     "SELECT s.context_id || '-' || s.seq AS find_id, c.site_id, s.context_id, s.seq, "
@@ -36,7 +78,7 @@ _SELECT = (
 
 def export_records(conn, context_id):
     """``(context, records)``: the context's row and its sherds as dicts in export order."""
-    validate_context_id(context_id)
+    context_id = validate_context_id(context_id)
     with conn, conn.cursor() as cur:
         cur.execute(
             "SELECT context_id, site_id, description, created_at FROM contexts "
@@ -69,22 +111,29 @@ def json_default(value):
     raise TypeError("cannot export %r" % (value,))
 
 
+def _rounded_record(rec):
+    return {
+        name: rounded(name, rec[name]) if kind == "float" else rec[name]
+        for name, kind, _ in COLUMNS
+    }
+
+
 def to_json(context, records):
     doc = {
         "format": EXPORT_FORMAT,
         "version": EXPORT_VERSION,
         "context": context,
         "columns": [{"name": n, "type": t, "description": d} for n, t, d in COLUMNS],
-        "sherds": records,
+        "sherds": [_rounded_record(r) for r in records],
     }
     return json.dumps(doc, default=json_default, indent=1, ensure_ascii=False) + "\n"
 
 
-def _cell(kind, value):
+def _cell(name, kind, value):
     if value is None:
         return ""
     if kind == "float":
-        return repr(float(value))
+        return repr(rounded(name, value))
     if kind == "timestamp":
         return _utc(value)
     return str(value)
@@ -95,7 +144,7 @@ def to_csv(records):
     w = csv.writer(out, lineterminator="\n")
     w.writerow([name for name, _, _ in COLUMNS])
     for rec in records:
-        w.writerow([_cell(kind, rec[name]) for name, kind, _ in COLUMNS])
+        w.writerow([_cell(name, kind, rec[name]) for name, kind, _ in COLUMNS])
     return out.getvalue()
 
 

@@ -16,6 +16,7 @@ No ROS here; the catalogue and the archive are passed in.
 import time
 
 from .archive import ARCHIVE_NAME, TEMP_NAME, owner_tag, sidecar_content, sidecar_relpath
+from .context_id import context_folder
 
 __all__ = ["repair_archive", "verify_archive", "TEMP_AGE"]
 
@@ -133,7 +134,7 @@ def verify_archive(catalogue, archive, context=None, temp_age=TEMP_AGE, clock=ti
     for c in contexts:
         old_temps = set(archive.temp_files(c, older_than=temp_age, now=clock()))
         for name in archive.files(c):
-            rel = "%s/%s" % (c, name)
+            rel = "%s/%s" % (context_folder(c), name)
             if rel in named:
                 continue
             if TEMP_NAME.match(name):
