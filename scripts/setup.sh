@@ -35,6 +35,7 @@ APT_PACKAGES=(
   xvfb xauth
   # field rig drivers (rascal_drivers): the scale's serial line, the DSLR through libgphoto2
   python3-serial python3-gphoto2
+  chromium poppler-utils fonts-dejavu-core  # rascal report --pdf (headless print) and its tests
 )
 # dpkg-query answers in a fraction of a second, so the check runs every time; a package it has
 # never heard of prints nothing, which also counts as missing.

@@ -5,7 +5,7 @@
     rascal export --context ID --format csv|json [--output FILE]
     rascal export --context ID --format field-desktop[-jsonl] --output DIR [--push URL]
     rascal run --context ID [--continue]   one batch on the rig (config from the parameter server)
-    rascal report --context ID             HTML page: thumbnails, measurements, time breakdown
+    rascal report --context ID [--pdf]     printable page (A4 HTML, PDF): sherds, colour, totals
     rascal verify [--context ID] [--repair] the image archive checked against the catalogue
     rascal contexts [--json]               each context: sherds by status, mass, first/last recorded
     rascal show FIND_ID [--json]           one sherd: every field, its files, history and edits
@@ -15,6 +15,7 @@
     rascal backup --output FILE            pg_dump -Fc + the image archive + SHA-256 manifest
     rascal restore FILE [--dsn DSN] [--archive DIR] [--force]   into an empty database
     rascal rerecord FIND_ID                a lost sherd put back on the mat, into its own row
+    rascal central init|add-rig|status|claim|release|push-archive   rigs and the central server
 
 The database comes from ``--dsn``, else ``$RASCAL_DSN``, else ``database.dsn`` of the site
 config (``--config``, else ``$RASCAL_CONFIG``, else config/rascal.yaml of the workspace; for
@@ -333,8 +334,14 @@ def cmd_report(args, out):
         "mean time per recorded sherd": "%.1f s" % (sum(totals) / len(totals)) if totals else "–",
     }
     archive = args.archive or cfg.resolve(cfg["archive"]["root"])
-    report = write_report(args.context, records, archive, summary)
+    modes = {"file_mode": cfg["archive"]["file_mode"], "dir_mode": cfg["archive"]["dir_mode"]}
+    report = write_report(args.context, records, archive, summary, context, **modes)
     print("report: %s" % report, file=out)
+    if args.pdf:
+        from rascal_tasks.report import print_pdf
+
+        pdf = print_pdf(report, file_mode=modes["file_mode"])
+        print("pdf: %s" % pdf, file=out)
     return 0
 
 
@@ -348,6 +355,10 @@ def cmd_verify(args, out):
 
     if args.context is not None:
         validate_context_id(args.context)
+    if args.central:  # the central archive against the replicated catalogue
+        from rascal_tasks.central_cli import verify_central_cmd
+
+        return verify_central_cmd(args, out)
     # the site config, unless --archive and --dsn / $RASCAL_DSN say everything it would
     needed = explicit_config_path(args) or not (
         args.archive and (args.dsn or os.environ.get("RASCAL_DSN"))
@@ -400,6 +411,11 @@ def _add_verify(sub):
         help="first rewrite stale or missing sidecars and remove old temporary files",
     )
     ver.add_argument("--archive", help="image archive root (default: archive.root of the config)")
+    ver.add_argument(
+        "--central",
+        action="store_true",
+        help="on the central server: its archive (--archive) against the replicated catalogue",
+    )
     ver.set_defaults(func=cmd_verify)
 
 
@@ -417,9 +433,16 @@ def _add_run(sub):
 
 
 def _add_report(sub):
-    rep = sub.add_parser("report", help="write an HTML report of a context's sherds")
+    rep = sub.add_parser(
+        "report", help="write a context's printable report (A4 HTML page, with --pdf a PDF)"
+    )
     rep.add_argument("--context", required=True, help="context id, e.g. TR1-1023")
     rep.add_argument("--archive", help="image archive root (default: archive.root of the config)")
+    rep.add_argument(
+        "--pdf",
+        action="store_true",
+        help="also print the page to <folder>.pdf with headless Chromium ($RASCAL_CHROMIUM)",
+    )
     rep.set_defaults(func=cmd_report)
 
 
@@ -842,6 +865,37 @@ def cmd_rerecord(args, out):
     return exit_codes.COMPLETE if status == "done" else exit_codes.INCOMPLETE
 
 
+def _add_doctor(sub):
+    doc = sub.add_parser(
+        "doctor",
+        help="check every device of the field rig (servos, scale, cameras); one line per fix",
+    )
+    doc.add_argument(
+        "--device",
+        action="append",
+        choices=("arm", "scale", "archival_camera", "wrist_camera"),
+        help="check only this device (repeatable; default: all four)",
+    )
+
+    def cmd_doctor(args, out):
+        from rascal_drivers import doctor
+
+        path = _config_path(args)
+        if path is None:
+            raise UsageError("no config/rascal.yaml here; pass --config")
+        cfg = load_site_config(path)
+        items = doctor.check_rig(cfg["drivers"], only=tuple(args.device or doctor.DEVICES))
+        return exit_codes.COMPLETE if doctor.report(items, out) else exit_codes.FAULT
+
+    doc.set_defaults(func=cmd_doctor)
+
+
+def _add_central(sub):
+    from rascal_tasks.central_cli import add_central
+
+    add_central(sub)
+
+
 def _add_rerecord(sub):
     p = sub.add_parser(
         "rerecord", help="record a lost sherd put back on the pickup mat into a row of its own"
@@ -1012,6 +1066,8 @@ def build_parser():
     _add_backup(sub)
     _add_restore(sub)
     _add_rerecord(sub)
+    _add_central(sub)
+    _add_doctor(sub)
     return p
 
 

@@ -9,8 +9,10 @@ event log and commits before it returns, so a crash loses at most the measuremen
 Sequence numbers are gap-free per context and safe under concurrent writers: the number is
 taken as MAX(seq)+1 inside the inserting transaction while the context's row is locked
 (SELECT ... FOR UPDATE), and UNIQUE (context_id, seq) backs it up. Nothing is counted in
-Python. After a crash, ``resume(context_id)`` hands back the unfinished rows so the restarted
-run continues them instead of recording the same sherd twice.
+Python. A context taken over from another rig (central.py) numbers on after that rig's last
+number (context_claims.seq_floor); keys (sherd_id, event_id) come from the rig's own block.
+After a crash, ``resume(context_id)`` hands back the unfinished rows so the restarted run
+continues them instead of recording the same sherd twice.
 
 A database failure never escapes as a psycopg2 exception: the transaction is rolled back and
 the call raises a one-line CatalogueError; a lost connection raises ConnectionLostError.
@@ -435,6 +437,7 @@ class Catalogue:
         validate_context_id(context_id)
         validate_site_id(site_id)
         check_text("description", description, 500)
+        self.claim_context(context_id)
         with self._tx("opening the context") as cur:
             cur.execute(
                 "INSERT INTO sites (site_id) VALUES (%s) ON CONFLICT DO NOTHING", (site_id,)
@@ -478,6 +481,15 @@ class Catalogue:
             "sherds": counts["n"],
             "unfinished": counts["open"],
         }
+
+    def claim_context(self, context_id):
+        """On a rig joined to a central server (``rascal central add-rig``): claim the
+        context there so that no other rig records it at the same time (ContextClaimed, one
+        line naming the rig that holds it); offline, a provisional claim (see central.py).
+        Nothing on a standalone catalogue. Returns the claim's state, or None."""
+        from .central import claim_context
+
+        return claim_context(self, context_id)
 
     # --- one sherd ---
     def new_sherd(self, context_id, pickup_xy=None, grasp_attempts=1, t_pick_s=None):
@@ -528,10 +540,13 @@ class Catalogue:
                         "INSERT INTO sherds (context_id, seq, status, pickup_x_m, pickup_y_m, "
                         "grasp_attempts, t_pick_s, rig, software_version, config_hash, "
                         "picked_at, updated_at) "
-                        "SELECT %s, COALESCE(MAX(seq), 0) + 1, 'picked', %s, %s, %s, %s, %s, %s, "
+                        "SELECT %s, GREATEST(COALESCE(MAX(seq), 0), (SELECT COALESCE(MAX("
+                        "seq_floor), 0) FROM context_claims WHERE context_id = %s)) + 1, "
+                        "'picked', %s, %s, %s, %s, %s, %s, "
                         "%s, %s, %s FROM sherds WHERE context_id = %s "
                         "RETURNING sherd_id, seq",
                         (
+                            context_id,
                             context_id,
                             px,
                             py,

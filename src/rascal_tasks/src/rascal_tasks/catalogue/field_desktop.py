@@ -59,10 +59,13 @@ __all__ = [
     "csv_files",
     "jsonl_text",
     "write_export",
+    "image_list",
     "push",
 ]
 
 CATEGORY = "Pottery"
+IMAGE_CATEGORY = "Photo"  # a subcategory of Image in Field's default configuration
+IMAGE_LIST = "field-image-import.json"  # in images/: the body of Field's POST /fileImport
 ARRAY_SEPARATOR = ";"  # Field's CsvExportConsts.ARRAY_SEPARATOR
 _ZERO_WIDTH = "\u200b\u200c\u200d\ufeff"  # dropped by Field's CSV parser
 MEASUREMENT_UNITS = {"weight": ("mg", "g", "kg"), "dimension": ("mm", "cm", "m")}
@@ -321,6 +324,21 @@ def jsonl_text(resources):
     return "".join(json.dumps(r, ensure_ascii=False) + "\n" for r in resources)
 
 
+def image_list(directory, names, category=IMAGE_CATEGORY):
+    """The image list of Field Desktop's image import for the files ``names`` of
+    ``<directory>/images``: the JSON body of its REST endpoint ``POST /fileImport``
+    (``filePaths``: absolute paths, whose file names become the images' identifiers, the names
+    ``relations.isDepictedIn`` gives; ``category``: the image category). Import the images
+    before the Pottery file, so that the relations find them."""
+    folder = os.path.abspath(os.path.join(directory, "images"))
+    doc = {
+        "filePaths": [os.path.join(folder, name) for name in names],
+        "category": category,
+        "readCreatorsFromMetadata": False,
+    }
+    return json.dumps(doc, ensure_ascii=False, indent=1) + "\n"
+
+
 def export_name(context_id):
     """The file name stem of a context's export: its folder name with '.' as '_' (Field
     reads the category from the '.'-separated parts of the name)."""
@@ -338,7 +356,8 @@ def write_export(
     dir_mode=0o755,
 ):
     """Validate, then write the export of one context into ``directory``: the Pottery file(s)
-    and ``images/<find>.png`` (copies of the archival images). Nothing is written when a value
+    and ``images/<find>.png`` (copies of the archival images) with the list of Field's image
+    import, ``images/field-image-import.json`` (``image_list``). Nothing is written when a value
     is refused or a file cannot be read; files appear under their final names only when all
     are complete (written in a temporary folder, then renamed). Returns
     ``{'files': [paths], 'resources': n, 'left_out': [find ids], 'bodies': [(name, text)]}``."""
@@ -352,6 +371,7 @@ def write_export(
     else:
         raise FieldError("format %r: must be csv or jsonl" % (fmt,))
     images = []
+    depicted = [n for res in resources for n in res["relations"].get("isDepictedIn", [])]
     for rec in records:
         if rec["status"] in EXPORTED_STATUSES and rec.get("image_path"):
             src = os.path.realpath(os.path.join(archive_root, rec["image_path"]))
@@ -361,6 +381,8 @@ def write_export(
                     "(`rascal verify`) or pass --archive" % (rec["find_id"], src, archive_root)
                 )
             images.append((image_name(context_id, rec["seq"]), src))
+    if sorted(depicted) != sorted(name for name, _ in images):  # pragma: no cover - a bug
+        raise FieldError("export: isDepictedIn %s and images %s differ" % (depicted, images))
     from .archive import make_dirs
 
     make_dirs(directory, dir_mode)
@@ -378,16 +400,24 @@ def write_export(
             path = os.path.join(stage, "images", fname)
             shutil.copyfile(src, path)
             staged.append((path, os.path.join(directory, "images", fname)))
-        for path, _ in staged:
+        listed = None
+        if images:
+            listed = os.path.join(stage, "images", IMAGE_LIST)
+            with open(listed, "w", encoding="utf-8") as f:
+                f.write(image_list(directory, [name for name, _ in images]))
+        for path, _ in staged + ([(listed, None)] if listed else []):
             os.chmod(path, file_mode)
         if images:
             make_dirs(os.path.join(directory, "images"), dir_mode)
         for path, final in staged:
             os.replace(path, final)
+        if listed:  # last: the list names only files that are in place
+            os.replace(listed, os.path.join(directory, "images", IMAGE_LIST))
     finally:
         shutil.rmtree(stage, ignore_errors=True)
     return {
         "files": [final for _, final in staged],
+        "image_list": os.path.join(directory, "images", IMAGE_LIST) if images else None,
         "resources": len(resources),
         "left_out": left_out,
         "bodies": bodies,
