@@ -3,7 +3,7 @@
 test: setup
 	bash scripts/test.sh
 demo: setup
-	bash scripts/demo.sh
+	RIG=$(RIG) bash scripts/demo.sh
 setup:
 	bash scripts/setup.sh
 clean:

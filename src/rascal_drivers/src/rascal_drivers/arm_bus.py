@@ -349,6 +349,11 @@ class ArmBus:
                 return ""
             for role, status in statuses.items():
                 if status:
+                    # dynamixel_sdk takes any status packet of the right ID as the answer, so a
+                    # late reply to the last state read (10 bytes) can pass for this 1-byte one:
+                    # a fault stops the arm, so it is read once more, alone, before it counts
+                    status = self._read(role, "hardware_error_status")
+                if status:
                     found.append("%s: %s" % (self._where(role), ct.describe_hardware_error(status)))
         return "hardware error on " + "; ".join(found) if found else ""
 

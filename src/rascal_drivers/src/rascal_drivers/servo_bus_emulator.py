@@ -35,6 +35,9 @@ class EmulatedServo:
         self.obstacle: Optional[float] = None  # ticks below which the horn cannot turn (a sherd)
         self.saturated_for = 0.0
         self.load = 0.0  # fraction of the maximum torque
+        # [ticks] where a simulator says the horn is (the emulated rig): replaces the motion model
+        self.external_position: Optional[float] = None
+        self.external_velocity = 0.0  # [ticks/s] its rate, from the same source
         self.set("model_number", model)
         self.set("firmware_version", 46)
         self.set("id", dxl_id)
@@ -94,19 +97,25 @@ class EmulatedServo:
         torque = self.get("torque_enable") and not self.get("hardware_error_status")
         if not torque:
             self.velocity = 0.0
+            if self.external_position is not None:
+                self.position = self.external_position
         else:
             goal = float(self.get("goal_position"))
             vmax = (self.get("profile_velocity") or self.get("velocity_limit")) * ct.VELOCITY_UNIT
             vmax_ticks = vmax * ct.TICKS_PER_REV / (2.0 * 3.141592653589793)
             v = max(-vmax_ticks, min(vmax_ticks, (goal - self.position) / TIME_CONSTANT))
             new = self.position + v * dt
-            if self.obstacle is not None and new < self.obstacle:
+            if self.external_position is not None:  # the simulated arm moves this servo
+                new = self.external_position
+            elif self.obstacle is not None and new < self.obstacle:
                 new = (
                     max(min(self.position, new), self.obstacle)
                     if self.position >= self.obstacle
                     else new
                 )
             self.velocity = (new - self.position) / dt if dt > 0 else 0.0
+            if self.external_position is not None:
+                self.velocity = self.external_velocity
             self.position = new
             load = abs(goal - self.position) * LOAD_PER_TICK
             limit = self.get("pwm_limit") / ct.XL430_PWM_LIMIT_MAX
@@ -154,6 +163,9 @@ class ServoBusEmulator:
                 os.unlink(link)
             os.symlink(self.device, link)
         self.lock = threading.Lock()
+        # the clock the servos move on: the wall clock, or the simulator's (the emulated rig,
+        # so a servo moves exactly as far as the simulated time the driver stamps it with)
+        self.clock = time.monotonic
         self.packets = 0
         self.crc_errors = 0
         self._stop = threading.Event()
@@ -192,7 +204,7 @@ class ServoBusEmulator:
     # ------------------------------------------------------------------ the bus
     def _run(self) -> None:
         buffer = bytearray()
-        last = time.monotonic()
+        last = self.clock()
         while not self._stop.is_set():
             try:
                 ready, _, _ = select.select([self.master], [], [], 0.002)
@@ -200,10 +212,10 @@ class ServoBusEmulator:
                     buffer += os.read(self.master, 4096)
             except OSError:
                 return
-            now = time.monotonic()
+            now = self.clock()
             with self.lock:
                 for s in self.servos.values():
-                    s.step(min(now - last, MAX_STEP))
+                    s.step(max(0.0, min(now - last, MAX_STEP)))
                 last = now
                 while True:
                     packet, need_more = p2.take_packet(buffer)

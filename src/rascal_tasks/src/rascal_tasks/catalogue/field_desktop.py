@@ -433,7 +433,7 @@ def push(url, bodies, password, fmt="csv", timeout=60.0, user="rascal"):
     base = url.rstrip("/")
     if not base.startswith(("http://", "https://")):
         raise FieldError(
-            "--push %r: must be Field Desktop's address, e.g. http://localhost:3001" % url
+            "--push %r: must be Field Desktop's address, e.g. http://localhost:3000" % url
         )
     query = urllib.parse.urlencode({"category": CATEGORY})
     endpoint = "%s/import/%s?%s" % (base, "csv" if fmt == "csv" else "jsonl", query)
