@@ -1036,7 +1036,7 @@ def _add_export(sub):
     ex.add_argument(
         "--push",
         metavar="URL",
-        help="also POST the Pottery file(s) to a running Field Desktop, e.g. http://localhost:3001",
+        help="also POST the Pottery file(s) to a running Field Desktop, e.g. http://localhost:3000",
     )
     ex.add_argument(
         "--field-password",
