@@ -19,6 +19,7 @@ import rospy
 
 from rascal_tasks import exit_codes
 from rascal_tasks.catalogue import Catalogue, ConnectionLostError, ImageArchive
+from rascal_tasks.catalogue.central import ContextClaimed
 from rascal_tasks.catalogue.context_batches import (
     START_RESUME,
     ContextInUse,
@@ -251,6 +252,8 @@ class Run:
                     log=rospy.loginfo,
                     min_free_mb=cfg["archive"]["min_free_mb"],
                 )
+            except ContextClaimed as e:  # another rig records this context: nothing moved
+                return fail(str(e), exit_codes.BUSY)
             except CatalogueError as e:
                 if not (isinstance(e, ConnectionLostError) or self.database_lost()):
                     return fail("database: %s" % e, exit_codes.FAULT)
