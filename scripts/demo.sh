@@ -37,6 +37,11 @@ fi
 
 rosrun rascal_tasks rascal db migrate
 echo "demo: context $context; simulator, arm_controller and sherd_detector start with rosrun"
+# then what an archaeologist takes away: the printable report (HTML and PDF), the Field Desktop
+# import files with the images, and a backup of the catalogue and archive that restores
+mkdir -p var/exports var/backups
 /usr/bin/python3 -m rascal_tasks.sim_rig -- bash -c "
   rosrun rascal_tasks rascal run --context '$context' &&
-  rosrun rascal_tasks rascal report --context '$context'"
+  rosrun rascal_tasks rascal report --context '$context' --pdf &&
+  rosrun rascal_tasks rascal export --context '$context' --format field-desktop --output 'var/exports/$context' &&
+  rosrun rascal_tasks rascal backup --output 'var/backups/$context.backup'"

@@ -5,13 +5,16 @@ workflow's units (kg, m, s); the catalogue keeps the archaeologists' units (g, m
 """
 
 import os
+import threading
 from typing import List, Tuple
 
 from rascal_tasks.catalogue import ArchiveError, Catalogue, ImageArchive, repair_archive
 from rascal_tasks.catalogue.archive import make_dirs, owner_tag
 from rascal_tasks.catalogue.context_id import context_folder
+from rascal_tasks.catalogue.errors import FieldError
 
 DEFAULT_MIN_FREE_MB = 1000  # archive.min_free_mb's default in the parameter schema
+ANALYSIS_WAIT = 120.0  # [s] longest wait for a photo's analysis when the sherd is done
 UNSTABLE_NOTE = "scale reading not stable"  # the note of a sherd recorded mass_unstable
 
 
@@ -36,6 +39,10 @@ class Recorder:
         self.context = context
         self.log = log or (lambda msg: None)
         self._ids = {}  # seq -> sherd_id
+        self._wrist = {}  # seq -> (length mm, width mm, height m) as the wrist camera saw it
+        self._pending = {}  # seq -> (thread, its result) of a photo's analysis under way
+        self.archival_geometry = None  # rascal_tasks.archival.Geometry (use_archival_station)
+        self.analyse_photos = True  # colour and size from each archival photo
         self._unfinished = None  # read once, at start-up
         archive.check(min_free_mb * 1000 * 1000)
         self.opened = catalogue.open_context(context, site)
@@ -55,6 +62,7 @@ class Recorder:
         return rec["seq"]
 
     def dimensions(self, seq, length, width, thickness):
+        self._wrist[seq] = (length * 1000.0, width * 1000.0, thickness)
         self.catalogue.record_dimensions(
             self._id(seq),
             length * 1000.0,
@@ -92,8 +100,76 @@ class Recorder:
         tag = owner_tag(self.catalogue.identity())
         return os.path.join(spool, "%s-%d-%s.png" % (context_folder(self.context), seq, tag))
 
+    def use_archival_station(self, station):
+        """The camera station's targets (chart and bar sizes, camera height; config.Station):
+        what the photo analysis may know. Where the targets lie is found in each photo."""
+        from rascal_tasks.archival.analysis import Geometry
+        from rascal_tasks.archival.chart import BarSpec, ChartSpec
+
+        cc, sb = station.colour_chart, station.scale_bar
+        self.archival_geometry = Geometry(
+            ChartSpec(cc.area.size[0] * 1000.0, cc.area.size[1] * 1000.0)
+            if cc is not None
+            else ChartSpec(),
+            BarSpec(sb.area.size[0] * 1000.0, sb.area.size[1] * 1000.0)
+            if sb is not None
+            else BarSpec(),
+            camera_height_m=station.camera_height,
+        )
+
+    def _wrist_size(self, seq):
+        """(length mm, width mm, height m) the wrist camera measured, or None."""
+        wrist = self._wrist.get(seq)
+        if wrist is None:  # a resumed sherd: what the catalogue holds
+            row = self.catalogue.get(self._id(seq))
+            if row.get("length_mm") and row.get("width_mm"):
+                wrist = (row["length_mm"], row["width_mm"], (row.get("thickness_mm") or 0) / 1e3)
+        return wrist
+
+    def _analyse(self, image_path, wrist):
+        """The archival analysis of an archived photo: (catalogue fields, note). Never raises:
+        any failure leaves the fields empty and says so in the note. No database access (it
+        runs beside the batch, in its own thread); the corrected copy is written here."""
+        try:
+            from rascal_tasks.archival import analyse, corrected_path, save_corrected
+
+            kwargs = {}
+            if self.archival_geometry is not None:
+                kwargs["geometry"] = self.archival_geometry
+            if wrist is not None:
+                kwargs["wrist_size_mm"] = wrist[:2]
+                # the outline seen from above is the sherd's top edge: its height as it lies
+                kwargs["object_height_m"] = wrist[2] or 0.0
+            r = analyse(image_path, **kwargs)
+        except Exception as e:  # noqa: BLE001  (the record must never be lost to the analysis)
+            line = str(e).splitlines()[0] if str(e) else type(e).__name__
+            return {}, "archival analysis failed: %s" % line
+        note = r.note()
+        try:
+            save_corrected(
+                r, corrected_path(image_path), self.archive.file_mode, self.archive.dir_mode
+            )
+        except (OSError, ValueError) as e:
+            note = "; ".join(filter(None, [note, "corrected image not saved: %s" % e]))
+        size = None
+        if r.length_mm is not None and not any(
+            f.startswith(("size disagrees", "size uncertain", "scale bar fit")) for f in r.flags
+        ):
+            size = (r.length_mm, r.width_mm)
+        fields = {
+            "size_mm": size,
+            "colour_munsell": r.munsell,
+            "colour_lab": list(r.lab_d50) if r.lab_d50 is not None else None,
+            "chart_delta_e00": r.chart_de00,
+            "px_per_cm": r.px_per_cm,
+        }
+        return {k: v for k, v in fields.items() if v is not None}, note
+
     def photo(self, seq, image_path: str, seconds: float = None) -> str:
-        """Archive the captured file atomically, then record its path and SHA-256."""
+        """Archive the captured file atomically, then record its path and SHA-256. The photo's
+        analysis (colour, Munsell chip, the chart's CIEDE2000, px/cm, a colour-corrected copy in
+        `corrected/` beside it; the archived original is only read) starts beside the batch and
+        is recorded when the sherd is done (`finish_analysis`)."""
         rec = self.catalogue.archive_photo(
             self._id(seq), self.archive, image_path, t_photo_s=seconds
         )
@@ -101,14 +177,79 @@ class Recorder:
             os.unlink(image_path)
         except OSError:
             pass
-        return self.archive.path(self.catalogue.get(rec["sherd_id"])["image_path"])
+        archived = self.archive.path(self.catalogue.get(rec["sherd_id"])["image_path"])
+        if self.analyse_photos:
+            wrist = self._wrist_size(seq)
+            out = {}
+            worker = threading.Thread(
+                target=lambda: out.update(result=self._analyse(archived, wrist)),
+                name="archival-%d" % seq,
+                daemon=True,
+            )
+            worker.start()
+            self._pending[seq] = (worker, out)
+        return archived
+
+    def finish_analysis(self, seq, wait: float = ANALYSIS_WAIT):
+        """Record the photo's analysis (waiting for it up to `wait` s): the colour columns and
+        px/cm, and a note with the archival size and any flag. A sherd photographed by a run
+        that stopped is analysed now. A failure never costs the record: the columns stay
+        empty and the note says why."""
+        if not self.analyse_photos:
+            return
+        pending = self._pending.pop(seq, None)
+        row = self.catalogue.get(self._id(seq))
+        if row["status"] != "photographed" or not row.get("image_path"):
+            return
+        if pending is None:
+            if row.get("colour_munsell") or row.get("px_per_cm"):
+                return  # recorded before
+            fields, note = self._analyse(
+                self.archive.path(row["image_path"]), self._wrist_size(seq)
+            )
+        else:
+            worker, out = pending
+            worker.join(wait)
+            fields, note = out.get("result") or ({}, "archival analysis did not finish in time")
+        size = fields.pop("size_mm", None)
+        if fields:
+            try:
+                self.catalogue.record_photo(
+                    self._id(seq),
+                    row["image_path"],
+                    row["image_sha256"],
+                    t_photo_s=row.get("t_photo_s"),
+                    **fields,
+                )
+            except FieldError as e:  # a value the catalogue refuses: the record without it
+                note = "; ".join(filter(None, [note, "archival values refused: %s" % e]))
+        if size is not None:
+            # the photo's length and width (the bar's scale, ~0.13 mm a pixel) replace the
+            # wrist camera's once the two agree; the note keeps both
+            try:
+                self.catalogue.record_dimensions(
+                    self._id(seq), size[0], size[1], row.get("thickness_mm")
+                )
+                if row.get("length_mm"):
+                    note += "; wrist camera L %.1f mm, W %.1f mm" % (
+                        row["length_mm"],
+                        row["width_mm"],
+                    )
+            except FieldError as e:
+                note = "; ".join(filter(None, [note, "archival size refused: %s" % e]))
+        if note:
+            self.catalogue.add_note(self._id(seq), "archival: " + note)
+            self.log("sherd %d archival: %s" % (seq, note))
 
     def done(self, seq, seconds: float = None, timings: dict = None):
+        self.finish_analysis(seq)
         self.catalogue.record_done(
             self._id(seq), t_discard_s=seconds, timings=timings, archive=self.archive
         )
 
     def lost(self, seq, reason: str, timings: dict = None):
+        if seq in self._pending:  # lost after its photo: the photo's colour is still its own
+            self.finish_analysis(seq)
         self.catalogue.record_lost(self._id(seq), reason, timings=timings)
         # a sherd lost after its photo: its sidecar says lost too
         self.catalogue.refresh_sidecar(self._id(seq), self.archive)

@@ -77,6 +77,11 @@ class AtStation(BatchState):
         b = self.batch
         plugin = b.plugins[self.index]
         s = b.sherd
+        if plugin.station.type == "archival_camera":
+            # the photo's analysis learns the chart's and bar's sizes (not where they lie)
+            use = getattr(b.recorder, "use_archival_station", None)
+            if use is not None and getattr(b.recorder, "archival_geometry", 0) is None:
+                use(plugin.station)
         outcome = plugin.after_place(s)
         if outcome == "missing":
             s.dropped("not at the %s after placing" % plugin.station.name)

@@ -1,0 +1,138 @@
+"""Colour correction of an archival photo from the 24 chart patches (colour-science).
+
+The photo's sRGB is decoded to linear RGB; a correction fitted from the patches' measured linear
+RGB to their published values (CIE L*a*b* D50 -> XYZ -> Bradford to D65 -> linear sRGB) maps
+every pixel to linear sRGB under D65. Patches that clip (any channel at 0 or 255 over part of
+the patch) are left out of the fit. The chart's accuracy after correction is the mean CIEDE2000
+of the 24 patches against their published L*a*b* (D50). No ROS here.
+"""
+
+import glob
+import os
+import sys
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), *[".."] * 5))
+
+
+def _import_colour():
+    """colour-science, from the workspace's .venv when run by /usr/bin/python3 (rosrun): its
+    site-packages appended, so Debian's numpy and cv2 stay first."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # colour-science warns once that matplotlib is missing
+        try:
+            import colour as c
+        except ImportError:
+            for path in glob.glob(
+                os.path.join(WORKSPACE, ".venv", "lib", "python3*", "site-packages")
+            ):
+                if path not in sys.path:
+                    sys.path.append(path)
+            import colour as c
+    return c
+
+
+colour = _import_colour()
+
+from rascal_tasks.archival.chart import chart_reference_lab  # noqa: E402
+
+SRGB = colour.RGB_COLOURSPACES["sRGB"]
+D50 = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D50"]
+D65 = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"]
+C = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["C"]
+METHOD = "Cheung 2004"  # 3 x 3 matrix (terms=3): exact for a diagonal light and a linear camera
+TERMS = 3
+CLIP_SHARE = 0.02  # a patch with more than this share of clipped pixels is left out of the fit
+
+
+def decode(srgb8: np.ndarray) -> np.ndarray:
+    """8-bit (or 0..255 float) sRGB -> linear RGB [0, 1]."""
+    return colour.cctf_decoding(np.asarray(srgb8, dtype=np.float64) / 255.0, function="sRGB")
+
+
+def encode(linear: np.ndarray) -> np.ndarray:
+    """linear RGB -> 8-bit sRGB (clipped)."""
+    v = colour.cctf_encoding(np.clip(linear, 0.0, 1.0), function="sRGB")
+    return np.clip(np.round(v * 255.0), 0, 255).astype(np.uint8)
+
+
+def linear_srgb_to_xyz_d65(rgb: np.ndarray) -> np.ndarray:
+    return np.asarray(rgb, dtype=np.float64) @ SRGB.matrix_RGB_to_XYZ.T
+
+
+def xyz_to_lab(xyz: np.ndarray, white_xy) -> np.ndarray:
+    return colour.XYZ_to_Lab(xyz, white_xy)
+
+
+def adapt(xyz: np.ndarray, from_xy, to_xy) -> np.ndarray:
+    return colour.chromatic_adaptation(
+        xyz,
+        colour.xy_to_XYZ(from_xy),
+        colour.xy_to_XYZ(to_xy),
+        method="Von Kries",
+        transform="Bradford",
+    )
+
+
+def linear_to_lab_d50(rgb: np.ndarray) -> np.ndarray:
+    """Linear sRGB (D65) -> CIE L*a*b* under D50 (Bradford), the catalogue's Lab."""
+    return xyz_to_lab(adapt(linear_srgb_to_xyz_d65(rgb), D65, D50), D50)
+
+
+def reference_linear() -> np.ndarray:
+    """The 24 patches' published L*a*b* (D50) as linear sRGB (D65), 24 x 3 (unclipped)."""
+    xyz50 = colour.Lab_to_XYZ(chart_reference_lab(), D50)
+    xyz65 = adapt(xyz50, D50, D65)
+    return xyz65 @ SRGB.matrix_XYZ_to_RGB.T
+
+
+def delta_e00(lab1, lab2) -> np.ndarray:
+    return colour.delta_E(lab1, lab2, method="CIE 2000")
+
+
+@dataclass
+class Correction:
+    """A fitted correction: apply() maps linear camera RGB to linear sRGB (D65)."""
+
+    matrix: np.ndarray  # the terms -> RGB matrix of colour-science's correction
+    used: np.ndarray  # bool, 24: patches the fit used
+    delta_e00: np.ndarray  # per patch, after correction (all 24)
+
+    @property
+    def mean_delta_e00(self) -> float:
+        return float(np.mean(self.delta_e00))
+
+    def apply(self, linear: np.ndarray) -> np.ndarray:
+        return colour.characterisation.apply_matrix_colour_correction(
+            linear, self.matrix, method=METHOD, terms=TERMS
+        )
+
+
+def fit(patches_srgb8: np.ndarray, clipped_share: np.ndarray) -> Correction:
+    """Fit the correction from the patches' measured 8-bit sRGB (24 x 3, chart order)."""
+    measured = decode(patches_srgb8)
+    used = np.asarray(clipped_share) <= CLIP_SHARE
+    if used.sum() < 8:
+        raise ValueError("colour chart: only %d of 24 patches unclipped, need 8" % used.sum())
+    ref = reference_linear()
+    M = colour.characterisation.matrix_colour_correction(
+        measured[used], ref[used], method=METHOD, terms=TERMS
+    )
+    corrected = colour.characterisation.apply_matrix_colour_correction(
+        measured, M, method=METHOD, terms=TERMS
+    )
+    de = delta_e00(linear_to_lab_d50(corrected), chart_reference_lab())
+    return Correction(M, used, de)
+
+
+def correct_image(rgb8: np.ndarray, corr: Correction) -> np.ndarray:
+    """The colour-corrected 8-bit sRGB image (a new array; the input is not changed)."""
+    lut = decode(np.arange(256))  # decode by table: a 2000 x 1500 photo in a blink
+    lin = lut[rgb8]
+    out = np.empty(rgb8.shape, np.uint8)
+    for y0 in range(0, rgb8.shape[0], 256):
+        out[y0 : y0 + 256] = encode(corr.apply(lin[y0 : y0 + 256]))
+    return out

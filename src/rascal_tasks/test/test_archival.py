@@ -1,0 +1,274 @@
+"""rascal_tasks.archival on synthetic photos: the chart and the bar at random rotation, scale and
+place, under colour casts and noise; colour correction, Munsell chip, size; failures as flags;
+the recorder's wiring (the record survives a failed analysis)."""
+
+import filecmp
+import hashlib
+import os
+
+import cv2
+import numpy as np
+import pytest
+
+from rascal_tasks.archival import analyse, analyse_rgb, chart, corrected_path
+from rascal_tasks.archival import colour as col
+from rascal_tasks.archival.munsell import soil_chart, within_one_chip
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SIM_DATA = os.path.join(HERE, "..", "..", "rascal_sim", "data")
+W, H = 1500, 1100
+
+
+def _place(canvas, ref, centre, px_per_mm, angle_deg):
+    """Draw a reference image (chart or bar, margin cut off) onto the canvas; returns the
+    true corners of the target."""
+    m = int(round(chart.MARGIN_MM * chart.REF_PX_PER_MM))
+    target = ref[m:-m, m:-m]
+    h, w = target.shape[:2]
+    s = px_per_mm / chart.REF_PX_PER_MM
+    a = np.radians(angle_deg)
+    R = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]) * s
+    t = np.asarray(centre) - R @ np.array([w / 2, h / 2])
+    A = np.hstack([R, t[:, None]])
+    warped = cv2.warpAffine(target, A, (canvas.shape[1], canvas.shape[0]), flags=cv2.INTER_AREA)
+    mask = cv2.warpAffine(np.full((h, w), 255, np.uint8), A, (canvas.shape[1], canvas.shape[0]))
+    canvas[mask > 127] = warped[mask > 127]
+    return (A @ np.array([[0, 0, 1], [w, 0, 1], [w, h, 1], [0, h, 1]], float).T).T
+
+
+def _sherd_polygon(centre, length_px, width_px, angle_deg):
+    a = np.radians(angle_deg)
+    u, v = np.array([np.cos(a), np.sin(a)]), np.array([-np.sin(a), np.cos(a)])
+    corners = [
+        (-1, -0.6),
+        (-0.6, -1),
+        (0.6, -1),
+        (1, -0.6),
+        (1, 0.6),
+        (0.6, 1),
+        (-0.6, 1),
+        (-1, 0.6),
+    ]
+    return np.array(
+        [centre + x * length_px / 2 * u + y * width_px / 2 * v for x, y in corners], np.int32
+    )
+
+
+def synthetic(
+    seed, chip="5YR 6/6", gains=(1.0, 1.0, 1.0), brightness=1.0, noise=2.0, bar=True, chart_in=True
+):
+    """A photo: table, chart and bar at random places, angles and scales, one octagonal
+    sherd; lit by per-channel `gains` (a colour cast) times `brightness`, with noise.
+    Returns (rgb8, truth)."""
+    rng = np.random.default_rng(seed)
+    px_per_mm = rng.uniform(4.0, 5.0)
+    img = np.empty((H, W, 3), np.uint8)
+    img[:] = (140, 128, 107)
+    truth = {"px_per_cm": px_per_mm * 10}
+    # three cells of a 2 x 2 layout, shuffled: chart, bar, sherd (each wholly in view)
+    cells = [(375, 275), (1125, 275), (375, 825), (1125, 825)]
+    order = rng.permutation(4)
+    if chart_in:
+        truth["chart"] = _place(
+            img, chart.chart_reference(), cells[order[0]], px_per_mm, rng.uniform(-180, 180)
+        )
+    if bar:
+        truth["bar"] = _place(
+            img, chart.bar_reference(), cells[order[1]], px_per_mm, rng.uniform(-180, 180)
+        )
+    L, Wd = rng.uniform(35, 60), rng.uniform(25, 34)
+    sherd_rgb = soil_chart().chips[soil_chart().by_name[chip]]
+    srgb = np.round(col.encode(col.decode(_chip_srgb8(sherd_rgb.notation))))
+    poly = _sherd_polygon(
+        np.array(cells[order[2]], float), L * px_per_mm, Wd * px_per_mm, rng.uniform(0, 180)
+    )
+    cv2.fillPoly(img, [poly], tuple(int(v) for v in srgb))
+    truth.update(length_mm=L, width_mm=Wd, chip=chip)
+    lin = col.decode(img) * np.asarray(gains) * brightness
+    out = col.encode(lin).astype(np.float64) + rng.normal(0, noise, img.shape)
+    return np.clip(np.round(out), 0, 255).astype(np.uint8), truth
+
+
+def _chip_srgb8(notation):
+    import csv
+
+    with open(
+        os.path.join(os.path.dirname(chart.CHART_CSV), "munsell_soil_hues_grid_renotation.csv")
+    ) as f:
+        for r in csv.DictReader(f):
+            if r["munsell"] == notation:
+                return np.array([float(r["sRGB_R8"]), float(r["sRGB_G8"]), float(r["sRGB_B8"])])
+    raise KeyError(notation)
+
+
+# the octagon's extents along its principal axes: 1 x 1 of its box (symmetric)
+@pytest.mark.parametrize(
+    "seed,chip,gains,brightness",
+    [
+        (1, "5YR 6/6", (1.0, 1.0, 1.0), 1.0),
+        (2, "10YR 7/3", (1.25, 1.0, 0.62), 0.8),  # tungsten-like cast, dimmer
+        (3, "2.5YR 4/6", (0.85, 0.95, 1.15), 0.6),  # cold and dim
+        (4, "7.5YR 5/2", (1.1, 1.0, 0.8), 1.1),
+    ],
+)
+def test_chart_bar_colour_and_size_at_random_poses_and_casts(seed, chip, gains, brightness):
+    rgb, truth = synthetic(seed, chip, gains, brightness)
+    r = analyse_rgb(rgb)
+    assert r.chart_reprojection_px is not None and r.chart_reprojection_px < 1.5
+    assert r.bar_reprojection_px is not None and r.bar_reprojection_px < 1.5
+    assert r.px_per_cm == pytest.approx(truth["px_per_cm"], rel=0.01)
+    assert r.chart_de00 < 1.5, r.flags
+    assert r.munsell is not None, r.flags
+    got, want = soil_chart().chip(r.munsell), soil_chart().chip(chip)
+    assert within_one_chip(got, want), (r.munsell, chip)
+    assert r.length_mm == pytest.approx(truth["length_mm"], abs=1.0)
+    assert r.width_mm == pytest.approx(truth["width_mm"], abs=1.0)
+    assert r.corrected is not None and r.corrected.shape == rgb.shape
+
+
+def test_chart_corners_found_where_drawn():
+    rgb, truth = synthetic(7, brightness=0.9)
+    loc = chart.find_chart(rgb)
+    # the same corner order as drawn (the homography knows the chart's orientation)
+    assert np.max(np.linalg.norm(loc.corners() - truth["chart"], axis=1)) < 3.0
+    patches, clipped = chart.sample_patches(rgb, loc)
+    ref = chart.chart_reference_srgb()
+    # dark skin darker than light skin, the neutral ramp falling: patches in chart order
+    assert patches[0].mean() < patches[1].mean()
+    assert all(np.diff(patches[18:24].mean(axis=1)) < 0)
+    assert np.corrcoef(patches.ravel(), ref.ravel())[0, 1] > 0.95
+
+
+def test_exact_chips_without_a_cast():
+    for i, chip in enumerate(["10R 5/8", "N4"]):
+        rgb, _ = synthetic(20 + i, chip, noise=1.0)
+        r = analyse_rgb(rgb)
+        assert r.munsell == chip, (r.munsell, chip, r.flags)
+
+
+def test_no_chart_no_colour_but_size_and_a_flag():
+    rgb, truth = synthetic(30, chart_in=False)
+    r = analyse_rgb(rgb)
+    assert r.munsell is None and r.lab_d50 is None and r.chart_de00 is None
+    assert any(f.startswith("no colour: colour chart") for f in r.flags)
+    assert r.px_per_cm == pytest.approx(truth["px_per_cm"], rel=0.01)
+
+
+def test_no_bar_no_size_and_a_flag():
+    rgb, _ = synthetic(31, bar=False)
+    r = analyse_rgb(rgb)
+    assert r.px_per_cm is None and r.length_mm is None
+    assert any(f.startswith("no size") for f in r.flags)
+    assert r.munsell is not None
+
+
+def test_wrist_disagreement_is_flagged():
+    rgb, truth = synthetic(32)
+    r = analyse_rgb(rgb, wrist_size_mm=(truth["length_mm"] + 6.0, truth["width_mm"]))
+    assert any(f.startswith("size disagrees") for f in r.flags)
+    r = analyse_rgb(rgb, wrist_size_mm=(truth["length_mm"] + 0.5, truth["width_mm"]))
+    assert not any(f.startswith("size disagrees") for f in r.flags)
+
+
+def test_blank_image_gives_flags_not_exceptions(tmp_path):
+    p = tmp_path / "blank.png"
+    cv2.imwrite(str(p), np.full((300, 400, 3), 128, np.uint8))
+    r = analyse(str(p))
+    assert r.munsell is None and r.px_per_cm is None and len(r.flags) >= 2
+
+
+def test_data_copies_match_the_simulator():
+    for name in ("colorchecker24_xrite_after2014_D50.csv", "munsell_soil_hues_grid_renotation.csv"):
+        ours = os.path.join(os.path.dirname(chart.CHART_CSV), name)
+        assert filecmp.cmp(ours, os.path.join(SIM_DATA, name), shallow=False), name
+
+
+def test_chip_round_trip_and_neighbours():
+    sc = soil_chart()
+    exact = 0
+    in_gamut = [
+        c
+        for c in sc.chips
+        if np.all((_chip_srgb8(c.notation) > 0) & (_chip_srgb8(c.notation) < 255))
+    ]
+    for c in in_gamut:
+        got, de = sc.nearest(col.decode(_chip_srgb8(c.notation)))
+        exact += got.notation == c.notation
+        assert within_one_chip(got, c), (c.notation, got.notation)
+    # 8-bit sRGB of a chip (the simulator's colour) names that chip again, inside sRGB's gamut
+    assert exact >= 0.97 * len(in_gamut), (exact, len(in_gamut))
+    assert within_one_chip(sc.chip("5YR 5/4"), sc.chip("7.5YR 6/6"))
+    assert not within_one_chip(sc.chip("5YR 5/4"), sc.chip("10YR 5/4"))
+    assert within_one_chip(sc.chip("N5"), sc.chip("10YR 5/1"))
+
+
+# --- the recorder: fields filled, corrected copy beside the original, the record kept ---
+
+
+def test_recorder_analyses_a_resumed_sherd_at_done(catalogue, tmp_path):
+    """A run stopped between photo and done: the next run's recorder analyses the archived
+    photo when the sherd is done."""
+    from rascal_tasks.catalogue import ImageArchive
+    from rascal_tasks.recorder import Recorder
+
+    archive = ImageArchive(str(tmp_path / "archive"))
+    first = Recorder(catalogue, archive, "C", "site")
+    first.analyse_photos = False
+    rgb, truth = synthetic(41, "10YR 6/3")
+    seq = first.new_sherd((0.1, 0.2))
+    first.mass(seq, 0.02)
+    capture = tmp_path / "capture.png"
+    cv2.imwrite(str(capture), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    first.photo(seq, str(capture))
+    again = Recorder(catalogue, archive, "C", "site")
+    again.done(seq)
+    row = catalogue.sherds("C")[0]
+    assert row["status"] == "done" and row["colour_munsell"] is not None
+    assert row["px_per_cm"] == pytest.approx(truth["px_per_cm"], rel=0.01)
+
+
+def test_recorder_fills_colour_and_keeps_the_original(catalogue, tmp_path):
+    from rascal_tasks.catalogue import ImageArchive
+    from rascal_tasks.recorder import Recorder
+
+    archive = ImageArchive(str(tmp_path / "archive"))
+    rec = Recorder(catalogue, archive, "C", "site")
+    rgb, truth = synthetic(40, "2.5YR 5/6", gains=(1.2, 1.0, 0.7), brightness=0.9)
+    seq = rec.new_sherd((0.1, 0.2))
+    rec.dimensions(seq, (truth["length_mm"] + 1.2) / 1000, truth["width_mm"] / 1000, 0.007)
+    rec.mass(seq, 0.0301)
+    capture = tmp_path / "capture.png"
+    cv2.imwrite(str(capture), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    sha = hashlib.sha256(capture.read_bytes()).hexdigest()
+    archived = rec.photo(seq, str(capture))
+    rec.done(seq)  # the analysis ran beside the batch; recorded when the sherd is done
+    row = catalogue.sherds("C")[0]
+    assert row["status"] == "done"
+    assert row["image_sha256"] == sha  # the original archived unaltered
+    assert hashlib.sha256(open(archived, "rb").read()).hexdigest() == sha
+    assert within_one_chip(soil_chart().chip(row["colour_munsell"]), soil_chart().chip("2.5YR 5/6"))
+    assert row["colour_l"] is not None and row["chart_delta_e00"] < 2.0
+    assert row["px_per_cm"] == pytest.approx(truth["px_per_cm"], rel=0.01)
+    assert os.path.exists(corrected_path(archived))
+    assert "archival photo: L" in (row["notes"] or "")
+    # the photo's size replaced the wrist camera's (they agreed)
+    assert row["length_mm"] == pytest.approx(truth["length_mm"], abs=1.0)
+    assert "wrist camera L" in row["notes"]
+
+
+def test_recorder_keeps_the_record_when_the_analysis_fails(catalogue, tmp_path):
+    from rascal_tasks.catalogue import ImageArchive
+    from rascal_tasks.recorder import Recorder
+
+    archive = ImageArchive(str(tmp_path / "archive"))
+    rec = Recorder(catalogue, archive, "C", "site")
+    seq = rec.new_sherd((0.1, 0.2))
+    rec.mass(seq, 0.0301)
+    capture = tmp_path / "capture.png"
+    cv2.imwrite(str(capture), np.full((200, 300, 3), 90, np.uint8))
+    rec.photo(seq, str(capture))
+    rec.done(seq)
+    row = catalogue.sherds("C")[0]
+    assert row["status"] == "done" and row["image_path"]
+    assert row["colour_munsell"] is None and row["px_per_cm"] is None
+    assert "archival:" in row["notes"] and "no colour" in row["notes"]
