@@ -91,6 +91,37 @@ def test_options_before_or_after_the_photo_give_the_same_result(tmp_path):
     assert "length mm" in a.stdout.splitlines()[0]  # the table by default
 
 
+@pytest.mark.parametrize(
+    "args",
+    [["{p}", "--json"], ["--json", "{p}"], ["--format", "json", "{p}"], ["{p}", "--json", "-"]],
+    ids=["json-last", "json-first", "format-json", "json-dash"],
+)
+def test_json_on_stdout_is_the_whole_output_however_asked(tmp_path, args):
+    photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
+    r = segment(*[a.format(p=photo) for a in args], "--no-overlay", cwd=tmp_path)
+    assert r.returncode in (0, 1), r.stderr
+    d = json.loads(r.stdout)  # nothing but the JSON, even with stderr merged in
+    assert r.stderr == "" and d["sherd_count"] == len(d["sherds"]) >= 1
+    assert d["summary"].startswith("%d sherds" % len(d["sherds"]))
+    assert not list(tmp_path.iterdir())  # the photo's name was not taken for a JSON file
+
+
+def test_a_read_only_folder_only_warns_about_the_default_overlay(tmp_path):
+    photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        r = segment(photo, "--json", cwd=ro)
+    finally:
+        ro.chmod(0o755)
+    if os.geteuid() == 0:  # root writes anyway: the overlay is simply there
+        assert (ro / "img040DSC02176_segmented.jpg").exists()
+    else:
+        assert "warning: cannot write the overlay" in r.stderr
+    assert r.returncode in (0, 1) and json.loads(r.stdout)["sherds"]
+
+
 def test_overlay_is_written_where_asked_and_by_default_beside(tmp_path):
     photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
     r = segment(photo, cwd=tmp_path)
@@ -142,7 +173,7 @@ def test_a_photo_without_a_scale_bar_is_doubtful_and_says_so(tmp_path):
     assert r.returncode == 1
     assert d["px_per_cm"] is None and any("no scale bar" in x for x in d["doubts"])
     assert all("no_scale" in s["flags"] for s in d["sherds"])
-    assert "no scale bar" in r.stderr
+    assert "no scale bar" in d["summary"] and r.stderr == ""  # on stdout the JSON says it all
 
 
 def test_json_round_trip_matches_the_table(tmp_path):

@@ -247,6 +247,43 @@ def test_an_empty_gripper_after_a_restart_is_only_opened(data):
     assert batch.rig.arm.at == tuple(batch.pickup.area.center)
 
 
+class _FellWhenKilled(_Recorder):
+    """A context whose sherd 2 (55 x 40 mm) was on its way to the scale when the run was
+    killed: it fell from the fingers."""
+
+    def unfinished(self):
+        return [(2, "picked", (0.15, 0.22))]
+
+    def wrist_size(self, seq):
+        return (0.055, 0.040) if seq == 2 else None
+
+
+def _fell_when_killed(data, world):
+    batch = _restarted_batch(data, world)
+    batch.recorder = _FellWhenKilled()
+    return batch
+
+
+def test_a_sherd_that_fell_back_onto_the_pickup_area_is_carried_on_under_its_number(data):
+    # It fell 12 cm from its pickup spot; a smaller sherd lies nearer that spot.
+    fallen, other = _obs(0.27, 0.22, 0.0545, 0.0405), _obs(0.16, 0.22, 0.030, 0.025)
+    batch = _fell_when_killed(data, {"pickup": [other, fallen]})
+    assert Resume(batch).run() == "TRANSLATE_0"
+    assert batch.sherd.seq == 2 and batch.sherd.observation is fallen
+    assert batch.rig.arm.at == (fallen.grasp_x, fallen.grasp_y)
+    notes = [c for c in batch.recorder.calls if c[0] == "note"]
+    assert notes and notes[0][1] == 2 and "by its size" in notes[0][2]
+    assert not [c for c in batch.recorder.calls if c[0] in ("lost", "new_sherd")]
+
+
+def test_a_fallen_sherd_is_never_taken_for_another_of_a_different_size(data):
+    batch = _fell_when_killed(data, {"pickup": [_obs(0.15, 0.22, 0.045, 0.040)]})
+    assert Resume(batch).run() == "SURVEY"
+    lost = [c for c in batch.recorder.calls if c[0] == "lost"]
+    assert lost and lost[0][1] == 2 and "was picked" in lost[0][2]
+    assert batch.lost == 1
+
+
 def test_the_selection_policies_order_the_merged_survey():
     a = _obs(0.10, 0.20, 0.040, 0.030)  # nearest the base
     b = _obs(0.30, 0.30, 0.060, 0.045)  # largest, far from the others

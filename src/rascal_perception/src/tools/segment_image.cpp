@@ -1,6 +1,8 @@
 // segment_image: sherds and the scale bar in a photo (no ROS). `segment_image --help` says it all.
 #include <getopt.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "rascal_perception/PhotoSegmenter.hpp"
 
@@ -26,7 +29,11 @@ const char* kHelp =
     "photo of sherds on a cloth, and measures each sherd in mm once the bar is found.\n"
     "\n"
     "options:\n"
-    "  --json FILE          write the result as JSON to FILE ('-': to stdout instead of the table)\n"
+    "  --json [FILE]        the result as JSON instead of the table: on stdout (no FILE, or '-'), else\n"
+    "                       written to FILE as well as the table; a FILE not ending in .json needs\n"
+    "                       --json=FILE. On stdout the JSON is all that is printed (its \"summary\"\n"
+    "                       and \"doubts\" say what the summary line on stderr says otherwise)\n"
+    "  --format table|json  the same as no --json / --json with no FILE\n"
     "  --overlay FILE       write the overlay image there (default: PHOTO-STEM_segmented.jpg in the\n"
     "                       current folder): outlines and ids, flagged sherds in orange, the bar\n"
     "  --no-overlay         write no overlay image\n"
@@ -45,6 +52,26 @@ const char* kHelp =
     "exit codes: 0 a confident result; 1 doubtful (no scale bar, a doubtful bar, a sherd\n"
     "flagged, or the background model not trusted: the summary line says which); 2 bad usage or\n"
     "an unreadable photo (one line on stderr).\n";
+
+bool endsWith(std::string s, const std::string& tail) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// `--json` takes the next word as its FILE only when it is '-' or a .json name: `--json` last,
+// before another option or before the photo means stdout (the common calls
+// `segment_image PHOTO --json` and `segment_image --json PHOTO`).
+std::vector<char*> withJsonFileResolved(int argc, char** argv) {
+  static char kStdout[] = "--json=-";
+  std::vector<char*> out(argv, argv + argc);
+  for (size_t i = 1; i < out.size(); ++i) {
+    if (std::string(out[i]) == "--") break;
+    if (std::string(out[i]) != "--json") continue;
+    const bool has_file = i + 1 < out.size() && (std::string(out[i + 1]) == "-" || endsWith(out[i + 1], ".json"));
+    if (!has_file) out[i] = kStdout;
+  }
+  return out;
+}
 
 int badUsage(const std::string& line) {
   std::fprintf(stderr, "segment_image: %s (segment_image --help lists the options)\n", line.c_str());
@@ -87,11 +114,20 @@ std::vector<std::string> doubts(const PhotoResult& r) {
   return d;
 }
 
+std::string summaryOf(const PhotoResult& r) {
+  std::string summary = std::to_string(r.sherds.size()) + " sherds, ";
+  summary += r.bar.found ? cv::format("scale bar %.2f px/cm", r.bar.px_per_cm) : std::string("no scale bar");
+  const std::vector<std::string> d = doubts(r);
+  for (const std::string& x : d) summary += "; " + x;
+  return summary + (d.empty() ? "" : " (doubtful: exit 1)");
+}
+
 std::string json(const std::string& image, const cv::Mat& rgb, const PhotoResult& r) {
   std::ostringstream o;
   o.setf(std::ios::fixed);
   o.precision(2);
-  o << "{\n  \"image\": \"" << escape(image) << "\",\n  \"width\": " << rgb.cols << ",\n  \"height\": " << rgb.rows
+  o << "{\n  \"image\": \"" << escape(image) << "\",\n  \"summary\": \"" << escape(summaryOf(r))
+    << "\",\n  \"sherd_count\": " << r.sherds.size() << ",\n  \"width\": " << rgb.cols << ",\n  \"height\": " << rgb.rows
     << ",\n";
   if (r.bar.found) {
     const cv::RotatedRect& b = r.bar.box;
@@ -175,6 +211,7 @@ cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
 
 int main(int argc, char** argv) {
   static const option kLong[] = {{"json", required_argument, nullptr, 'j'},
+                                 {"format", required_argument, nullptr, 'f'},
                                  {"overlay", required_argument, nullptr, 'o'},
                                  {"no-overlay", no_argument, nullptr, 'n'},
                                  {"mask", required_argument, nullptr, 'm'},
@@ -187,12 +224,18 @@ int main(int argc, char** argv) {
   bool overlay = true;
   PhotoSegmenter::Options options;
   opterr = 0;  // our own one-line messages
+  std::vector<char*> args = withJsonFileResolved(argc, argv);
+  argv = args.data();
   int c;
   while ((c = getopt_long(argc, argv, ":h", kLong, nullptr)) != -1) {
     const std::string arg = optarg ? optarg : "";
     try {
       switch (c) {
         case 'j': json_path = arg; break;
+        case 'f':
+          if (arg == "json") json_path = "-";
+          else if (arg != "table") return badUsage("bad value '" + arg + "' for --format (table or json)");
+          break;
         case 'o': overlay_path = arg; break;
         case 'n': overlay = false; break;
         case 'm': mask_path = arg; break;
@@ -221,7 +264,8 @@ int main(int argc, char** argv) {
   if (optind >= argc) return badUsage("no photo given");
   if (argc - optind > 1) return badUsage("one photo at a time; got '" + std::string(argv[optind + 1]) + "' too");
   const std::string image = argv[optind];
-  if (overlay && overlay_path.empty()) overlay_path = std::filesystem::path(image).stem().string() + "_segmented.jpg";
+  const bool default_overlay = overlay && overlay_path.empty();
+  if (default_overlay) overlay_path = std::filesystem::path(image).stem().string() + "_segmented.jpg";
   cv::setNumThreads(1);
   PhotoResult r;
   cv::Mat rgb;
@@ -246,15 +290,23 @@ int main(int argc, char** argv) {
     if (overlay) {
       cv::Mat bgr;
       cv::cvtColor(annotate(rgb, r), bgr, cv::COLOR_RGB2BGR);
-      if (!cv::imwrite(overlay_path, bgr)) throw std::runtime_error("cannot write --overlay " + overlay_path);
+      bool written = false;
+      try {
+        written = cv::imwrite(overlay_path, bgr);
+      } catch (const cv::Exception&) {
+      }
+      // The default overlay lands in the current folder, which may be read-only: the result is
+      // still good, so that is a warning; an --overlay asked for is an error.
+      if (!written && default_overlay) {
+        std::fprintf(stderr, "segment_image: warning: cannot write the overlay %s here; use --overlay FILE or --no-overlay\n",
+                     overlay_path.c_str());
+      } else if (!written) {
+        throw std::runtime_error("cannot write --overlay " + overlay_path);
+      }
     }
   } catch (const std::exception& e) {
     return badUsage(e.what());
   }
-  const std::vector<std::string> d = doubts(r);
-  std::string summary = std::to_string(r.sherds.size()) + " sherds, ";
-  summary += r.bar.found ? cv::format("scale bar %.2f px/cm", r.bar.px_per_cm) : std::string("no scale bar");
-  for (const std::string& x : d) summary += "; " + x;
-  std::fprintf(stderr, "segment_image: %s%s\n", summary.c_str(), d.empty() ? "" : " (doubtful: exit 1)");
-  return d.empty() ? kConfident : kDoubtful;
+  if (json_path != "-") std::fprintf(stderr, "segment_image: %s\n", summaryOf(r).c_str());
+  return doubts(r).empty() ? kConfident : kDoubtful;
 }

@@ -6,7 +6,7 @@ workflow's units (kg, m, s); the catalogue keeps the archaeologists' units (g, m
 
 import os
 import threading
-from typing import List, Tuple
+from typing import List, Optional, Tuple
 
 from rascal_tasks.catalogue import ArchiveError, Catalogue, ImageArchive, repair_archive
 from rascal_tasks.catalogue.archive import make_dirs, owner_tag
@@ -116,6 +116,11 @@ class Recorder:
             else BarSpec(),
             camera_height_m=station.camera_height,
         )
+
+    def wrist_size(self, seq) -> Optional[Tuple[float, float]]:
+        """(length, width) in m the wrist camera measured for sherd `seq`, or None."""
+        wrist = self._wrist_size(seq)
+        return None if wrist is None else (wrist[0] / 1000.0, wrist[1] / 1000.0)
 
     def _wrist_size(self, seq):
         """(length mm, width mm, height m) the wrist camera measured, or None."""

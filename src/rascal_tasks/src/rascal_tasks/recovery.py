@@ -4,8 +4,16 @@ No ROS in here.
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
+from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.survey import survey_at, survey_pickup_area
+
+
+def unlikeness(c: Observation, length: float, width: float, ref) -> float:
+    """How unlike a detection `c` is a sherd of `length` x `width` (m) last seen at `ref`.
+    A drop scatters a sherd by centimetres; its size is measured within ~3 mm, so a size
+    difference weighs four times a distance."""
+    return c.distance_to(*ref) + 4 * (abs(c.length - length) + abs(c.width - width))
 
 
 class Recover(BatchState):
@@ -34,16 +42,10 @@ class Recover(BatchState):
                 % (s.where, ", nor in the pickup area" if s.station_index < 0 else "")
             )
 
-        def unlikeness(c):
-            # A drop scatters a sherd by centimetres; its size is measured within ~3 mm, so a
-            # size difference weighs four times a distance.
-            return c.distance_to(*ref) + 4 * (
-                abs(c.length - like.length) + abs(c.width - like.width)
-            )
+        def unlike(c, _last=None):
+            return unlikeness(c, like.length, like.width, ref)
 
-        o, tries, held = grasp_retrying(
-            b, min(candidates, key=unlikeness), station, like=lambda c, _last: unlikeness(c)
-        )
+        o, tries, held = grasp_retrying(b, min(candidates, key=unlike), station, like=unlike)
         if not held:
             return self.lose("found but could not be picked up (%d grasps)" % tries)
         b.event(

@@ -4,14 +4,22 @@ found and carried on with). No ROS in here.
 """
 
 from rascal_tasks.batch import BatchState
-from rascal_tasks.manipulation import grasp
+from rascal_tasks.manipulation import grasp, grasp_retrying
+from rascal_tasks.recovery import unlikeness
 from rascal_tasks.rig import Timings
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.survey import camera_over, survey_at
+from rascal_tasks.survey import camera_over, survey_at, survey_pickup_area
 
 # ee_gripper_link height above the pickup mat where Home lets go of a sherd found in the fingers
 # after a restart: fingertips 4.4 mm lower, so a sherd up to ~2 cm thick drops a few mm at most.
 PUT_BACK_HEIGHT = 0.025
+
+# A sherd that fell from the fingers when the run died, found again on the pickup area, is
+# known only by the size the wrist camera measured before (within ~1 mm in the simulator; a
+# sherd landing on its other face shows about the same outline): a detection is taken for it
+# only when both its length and its width are this close.
+SAME_SIZE_M = 0.003
+SAME_SIZE_FRACTION = 0.06
 
 
 class Home(BatchState):
@@ -94,7 +102,13 @@ class Resume(BatchState):
     Outcomes name the state to go on with: TRANSLATE_k (it was in the gripper; Home set it
     down at its pickup spot and it is picked up again),
     STATION_i (it lies placed at station i, not yet measured there), REPICK_i (it lies at
-    station i, measured), or SURVEY (nothing unfinished, or it is lost)."""
+    station i, measured), or SURVEY (nothing unfinished, or it is lost).
+
+    A sherd that was on its way from the pickup area to the first station when the run died
+    fell from the fingers: onto the first station, or back onto the pickup area, where the
+    next survey would take it for a new sherd and record it twice. There it is looked for by
+    its size and, found, carried on with under its own number (with a note saying how it was
+    known); only a sherd found nowhere is recorded lost."""
 
     next_sherd = "SURVEY"
 
@@ -112,7 +126,7 @@ class Resume(BatchState):
         rows = b.recorder.unfinished()
         if not rows:
             return "SURVEY"
-        seq, status, _pickup_xy = rows[0]
+        seq, status, pickup_xy = rows[0]
         statuses = [p.status for p in b.plugins]
         done = statuses.index(status) if status in statuses else -1
         b.event(None, "resume", "sherd %d was %s" % (seq, status))
@@ -128,8 +142,45 @@ class Resume(BatchState):
                 s.seen(seen[0], st)
                 s.station_done(done)
                 return ("REPICK_%d" if i == done else "STATION_%d") % i
+        if done < 0 and self.pick_fallen(s, pickup_xy):
+            return "TRANSLATE_0"
         s.lose("not found after restart (was %s)" % status)
         return "SURVEY"
+
+    def pick_fallen(self, s: SherdRecord, pickup_xy) -> bool:
+        """Look over the pickup area for the sherd `s` that fell from the fingers, by the size
+        the wrist camera measured; pick up the one most like it. True when it is held."""
+        b = self.batch
+        size = b.recorder.wrist_size(s.seq)
+        if size is None:
+            return False
+        length, width = size
+
+        def alike(c):
+            return abs(c.length - length) <= max(SAME_SIZE_M, SAME_SIZE_FRACTION * length) and abs(
+                c.width - width
+            ) <= max(SAME_SIZE_M, SAME_SIZE_FRACTION * width)
+
+        candidates = [c for c in survey_pickup_area(b) if alike(c)]
+        if not candidates:
+            return False
+
+        def unlike(c, _last=None):
+            return unlikeness(c, length, width, pickup_xy)
+
+        o, _tries, held = grasp_retrying(b, min(candidates, key=unlike), b.pickup, like=unlike)
+        if not held:
+            return False
+        s.seen(o, b.pickup)
+        s.picked_xy = (o.x, o.y)
+        text = (
+            "fell from the gripper when the run stopped; found again on the pickup area at "
+            "(%.3f, %.3f) m by its size (%.1f x %.1f mm; %d detection(s) of that size)"
+            % (o.x, o.y, o.length * 1000, o.width * 1000, len(candidates))
+        )
+        b.event(s, "refound", text)
+        s.note(text)
+        return True
 
     def pick_put_back(self, s: SherdRecord, done: int) -> str:
         b = self.batch
