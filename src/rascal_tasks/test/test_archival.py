@@ -4,6 +4,7 @@ the recorder's wiring (the record survives a failed analysis)."""
 
 import filecmp
 import hashlib
+import json
 import os
 
 import cv2
@@ -207,7 +208,7 @@ def test_chip_round_trip_and_neighbours():
 
 def test_recorder_analyses_a_resumed_sherd_at_done(catalogue, tmp_path):
     """A run stopped between photo and done: the next run's recorder analyses the archived
-    photo when the sherd is done."""
+    photo at the end of its batch."""
     from rascal_tasks.catalogue import ImageArchive
     from rascal_tasks.recorder import Recorder
 
@@ -222,6 +223,7 @@ def test_recorder_analyses_a_resumed_sherd_at_done(catalogue, tmp_path):
     first.photo(seq, str(capture))
     again = Recorder(catalogue, archive, "C", "site")
     again.done(seq)
+    again.collect_analyses(wait=60)
     row = catalogue.sherds("C")[0]
     assert row["status"] == "done" and row["colour_munsell"] is not None
     assert row["px_per_cm"] == pytest.approx(truth["px_per_cm"], rel=0.01)
@@ -241,7 +243,8 @@ def test_recorder_fills_colour_and_keeps_the_original(catalogue, tmp_path):
     cv2.imwrite(str(capture), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
     sha = hashlib.sha256(capture.read_bytes()).hexdigest()
     archived = rec.photo(seq, str(capture))
-    rec.done(seq)  # the analysis ran beside the batch; recorded when the sherd is done
+    rec.done(seq)  # the analysis ran beside the batch
+    rec.collect_analyses(wait=60)  # the end of the batch
     row = catalogue.sherds("C")[0]
     assert row["status"] == "done"
     assert row["image_sha256"] == sha  # the original archived unaltered
@@ -268,7 +271,115 @@ def test_recorder_keeps_the_record_when_the_analysis_fails(catalogue, tmp_path):
     cv2.imwrite(str(capture), np.full((200, 300, 3), 90, np.uint8))
     rec.photo(seq, str(capture))
     rec.done(seq)
+    rec.collect_analyses(wait=60)
     row = catalogue.sherds("C")[0]
     assert row["status"] == "done" and row["image_path"]
     assert row["colour_munsell"] is None and row["px_per_cm"] is None
     assert "archival:" in row["notes"] and "no colour" in row["notes"]
+
+
+def test_done_never_waits_for_the_analysis_and_it_is_recorded_after(catalogue, tmp_path):
+    """The sherd is done (and the arm goes on) while its photo is still being analysed; the
+    values reach the row and the image's sidecar once the analysis has finished."""
+    import json
+    import threading
+    import time
+
+    from rascal_tasks.catalogue import ImageArchive
+    from rascal_tasks.recorder import Recorder
+
+    archive = ImageArchive(str(tmp_path / "archive"))
+    rec = Recorder(catalogue, archive, "C", "site")
+    release = threading.Event()
+    analyse = rec._analyse
+    rec._analyse = lambda *a: (release.wait(30), analyse(*a))[1]
+    rgb, truth = synthetic(42, "7.5YR 6/4")
+    seq = rec.new_sherd((0.1, 0.2))
+    rec.mass(seq, 0.02)
+    capture = tmp_path / "capture.png"
+    cv2.imwrite(str(capture), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    archived = rec.photo(seq, str(capture))
+    t = time.monotonic()
+    rec.done(seq)
+    assert time.monotonic() - t < 5.0  # the analysis is held back: done did not wait for it
+    row = catalogue.sherds("C")[0]
+    assert row["status"] == "done" and row["colour_munsell"] is None
+    release.set()
+    rec.collect_analyses(wait=60)
+    row = catalogue.sherds("C")[0]
+    assert row["status"] == "done" and row["colour_munsell"] is not None
+    assert row["px_per_cm"] == pytest.approx(truth["px_per_cm"], rel=0.01)
+    sidecar = json.loads(open(os.path.splitext(archived)[0] + ".json").read())
+    assert sidecar["colour_munsell"] == row["colour_munsell"] and sidecar["status"] == "done"
+    rec.collect_analyses(wait=60)  # nothing twice
+    assert catalogue.sherds("C")[0]["notes"].count("archival: ") == 1
+
+
+# --- the analysis offline: every sherd of a photo with the chart in view (archival_photo) ---
+
+
+def _several(seed, chips, gains=(1.0, 1.0, 1.0), brightness=1.0):
+    """A photo with the chart, the bar and one sherd per chip in a row below them, under a
+    colour cast. Returns (rgb8, [(centre, length mm, width mm, chip)], px/cm)."""
+    rng = np.random.default_rng(seed)
+    px_per_mm = rng.uniform(3.2, 3.6)
+    img = np.empty((H, W, 3), np.uint8)
+    img[:] = (62, 60, 58)  # a dark cloth
+    _place(img, chart.chart_reference(), (420, 300), px_per_mm, rng.uniform(-20, 20))
+    _place(img, chart.bar_reference(), (1130, 300), px_per_mm, rng.uniform(-20, 20))
+    truth = []
+    for k, chip in enumerate(chips):
+        centre = np.array([200.0 + k * (1100.0 / max(1, len(chips) - 1)), 820.0])
+        L, Wd = rng.uniform(40, 60), rng.uniform(25, 34)
+        srgb = np.round(col.encode(col.decode(_chip_srgb8(chip))))
+        poly = _sherd_polygon(centre, L * px_per_mm, Wd * px_per_mm, rng.uniform(0, 180))
+        cv2.fillPoly(img, [poly], tuple(int(v) for v in srgb))
+        truth.append((centre, L, Wd, chip))
+    lin = col.decode(img) * np.asarray(gains) * brightness
+    out = col.encode(lin).astype(np.float64) + rng.normal(0, 2.0, img.shape)
+    return np.clip(np.round(out), 0, 255).astype(np.uint8), truth, px_per_mm * 10
+
+
+@pytest.mark.parametrize(
+    "seed,gains,brightness", [(51, (1.0, 1.0, 1.0), 1.0), (52, (1.2, 1.0, 0.7), 0.85)]
+)
+def test_archival_photo_measures_every_sherd_of_a_photo_offline(tmp_path, seed, gains, brightness):
+    import subprocess
+
+    chips = ["10YR 7/3", "2.5YR 5/6", "7.5YR 4/2", "5YR 6/4"]
+    rgb, truth, px_per_cm = _several(seed, chips, gains, brightness)
+    photo = tmp_path / "several.png"
+    cv2.imwrite(str(photo), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    r = subprocess.run(
+        ["rosrun", "rascal_tasks", "archival_photo", str(photo), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert r.returncode in (0, 1), r.stderr
+    d = json.loads(r.stdout)
+    assert d["chart_delta_e00"] is not None and d["chart_delta_e00"] < 2.0
+    assert d["px_per_cm"] == pytest.approx(px_per_cm, rel=0.02)
+    assert len(d["sherds"]) == len(truth), [s["centre_px"] for s in d["sherds"]]
+    for centre, L, Wd, chip in truth:
+        s = min(d["sherds"], key=lambda s: np.hypot(*(np.array(s["centre_px"]) - centre)))
+        assert np.hypot(*(np.array(s["centre_px"]) - centre)) < 20
+        got = soil_chart().chip(s["munsell"])
+        assert within_one_chip(got, soil_chart().chip(chip)), (chip, s["munsell"])
+        assert s["length_mm"] == pytest.approx(L, abs=1.0), (chip, s)
+        assert s["width_mm"] == pytest.approx(Wd, abs=1.0), (chip, s)
+
+
+def test_archival_photo_without_a_photo_is_one_line_and_exit_2(tmp_path):
+    import subprocess
+
+    r = subprocess.run(
+        ["rosrun", "rascal_tasks", "archival_photo", str(tmp_path / "none.jpg")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "does not exist" in r.stderr

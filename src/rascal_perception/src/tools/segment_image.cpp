@@ -38,6 +38,7 @@ const char* kHelp =
     "                       current folder): outlines and ids, flagged sherds in orange, the bar\n"
     "  --no-overlay         write no overlay image\n"
     "  --mask FILE          write the foreground mask (PNG)\n"
+    "  --labels FILE        write each sherd's outline filled with its id (16-bit PNG, 0 = none)\n"
     "  --background FILE    a photo of the empty cloth from the same camera (default: learnt from\n"
     "                       the photo itself)\n"
     "  --bar-length CM      printed length of the scale bar (default 10)\n"
@@ -215,12 +216,13 @@ int main(int argc, char** argv) {
                                  {"overlay", required_argument, nullptr, 'o'},
                                  {"no-overlay", no_argument, nullptr, 'n'},
                                  {"mask", required_argument, nullptr, 'm'},
+                                 {"labels", required_argument, nullptr, 'L'},
                                  {"background", required_argument, nullptr, 'b'},
                                  {"bar-length", required_argument, nullptr, 'l'},
                                  {"clusters", required_argument, nullptr, 'k'},
                                  {"help", no_argument, nullptr, 'h'},
                                  {nullptr, 0, nullptr, 0}};
-  std::string json_path, overlay_path, mask_path, background;
+  std::string json_path, overlay_path, mask_path, labels_path, background;
   bool overlay = true;
   PhotoSegmenter::Options options;
   opterr = 0;  // our own one-line messages
@@ -239,6 +241,7 @@ int main(int argc, char** argv) {
         case 'o': overlay_path = arg; break;
         case 'n': overlay = false; break;
         case 'm': mask_path = arg; break;
+        case 'L': labels_path = arg; break;
         case 'b': background = arg; break;
         case 'l': {
           size_t used = 0;
@@ -287,6 +290,14 @@ int main(int argc, char** argv) {
       table(r, std::cout);
     }
     if (!mask_path.empty() && !cv::imwrite(mask_path, r.foreground)) throw std::runtime_error("cannot write --mask " + mask_path);
+    if (!labels_path.empty()) {  // the ids of the table and the JSON, for tools that measure each sherd
+      cv::Mat labels = cv::Mat::zeros(rgb.size(), CV_16U);
+      for (size_t i = 0; i < r.sherds.size(); ++i) {
+        cv::drawContours(labels, std::vector<std::vector<cv::Point>>{r.sherds[i].blob.contour}, 0,
+                         cv::Scalar(static_cast<double>(i + 1)), cv::FILLED);
+      }
+      if (!cv::imwrite(labels_path, labels)) throw std::runtime_error("cannot write --labels " + labels_path);
+    }
     if (overlay) {
       cv::Mat bgr;
       cv::cvtColor(annotate(rgb, r), bgr, cv::COLOR_RGB2BGR);

@@ -6,6 +6,7 @@ workflow's units (kg, m, s); the catalogue keeps the archaeologists' units (g, m
 
 import os
 import threading
+import time
 from typing import List, Optional, Tuple
 
 from rascal_tasks.catalogue import ArchiveError, Catalogue, ImageArchive, repair_archive
@@ -16,6 +17,15 @@ from rascal_tasks.catalogue.errors import FieldError
 DEFAULT_MIN_FREE_MB = 1000  # archive.min_free_mb's default in the parameter schema
 ANALYSIS_WAIT = 120.0  # [s] longest wait for a photo's analysis when the sherd is done
 UNSTABLE_NOTE = "scale reading not stable"  # the note of a sherd recorded mass_unstable
+FINAL_STATUSES = ("done", "lost")
+
+
+def _analysed(row) -> bool:
+    """Whether a sherd's archival photo was analysed: values or an `archival:` note."""
+    notes = row.get("notes") or ""
+    return bool(row.get("colour_munsell") or row.get("px_per_cm")) or any(
+        line.startswith("archival: ") for line in notes.splitlines()
+    )
 
 
 class Recorder:
@@ -173,8 +183,10 @@ class Recorder:
     def photo(self, seq, image_path: str, seconds: float = None) -> str:
         """Archive the captured file atomically, then record its path and SHA-256. The photo's
         analysis (colour, Munsell chip, the chart's CIEDE2000, px/cm, a colour-corrected copy in
-        `corrected/` beside it; the archived original is only read) starts beside the batch and
-        is recorded when the sherd is done (`finish_analysis`)."""
+        `corrected/` beside it; the archived original is only read) runs beside the batch and
+        is recorded when it has finished (`collect_analyses`), after the sherd is done if need
+        be: the arm never waits for it."""
+        self.collect_analyses()
         rec = self.catalogue.archive_photo(
             self._id(seq), self.archive, image_path, t_photo_s=seconds
         )
@@ -195,20 +207,40 @@ class Recorder:
             self._pending[seq] = (worker, out)
         return archived
 
+    def collect_analyses(self, wait: float = 0.0):
+        """Record every photo analysis that has finished; with `wait` > 0, wait up to `wait` s
+        in all for those still running (the end of a batch), and look for done sherds of the
+        context whose photo was never analysed (a run that stopped in between): they are
+        analysed now. What did not finish in time is noted, never lost silently."""
+        deadline = time.monotonic() + wait
+        for seq in sorted(self._pending):
+            worker, out = self._pending[seq]
+            if wait > 0:
+                worker.join(max(0.0, deadline - time.monotonic()))
+            if worker.is_alive() and wait <= 0:
+                continue
+            del self._pending[seq]
+            fields, note = out.get("result") or ({}, "archival analysis did not finish in time")
+            self._write_analysis(seq, fields, note)
+        if wait > 0:
+            for row in self.catalogue.sherds(self.context, ("done",)):
+                if row.get("image_path") and not _analysed(row):
+                    self._ids[row["seq"]] = row["sherd_id"]
+                    fields, note = self._analyse(
+                        self.archive.path(row["image_path"]), self._wrist_size(row["seq"])
+                    )
+                    self._write_analysis(row["seq"], fields, note)
+
     def finish_analysis(self, seq, wait: float = ANALYSIS_WAIT):
-        """Record the photo's analysis (waiting for it up to `wait` s): the colour columns and
-        px/cm, and a note with the archival size and any flag. A sherd photographed by a run
-        that stopped is analysed now. A failure never costs the record: the columns stay
-        empty and the note says why."""
+        """Record sherd `seq`'s photo analysis now, waiting for it up to `wait` s (a sherd lost
+        after its photo; a photographed sherd a stopped run left, analysed now)."""
         if not self.analyse_photos:
             return
         pending = self._pending.pop(seq, None)
-        row = self.catalogue.get(self._id(seq))
-        if row["status"] != "photographed" or not row.get("image_path"):
-            return
         if pending is None:
-            if row.get("colour_munsell") or row.get("px_per_cm"):
-                return  # recorded before
+            row = self.catalogue.get(self._id(seq))
+            if not row.get("image_path") or _analysed(row):
+                return
             fields, note = self._analyse(
                 self.archive.path(row["image_path"]), self._wrist_size(seq)
             )
@@ -216,41 +248,37 @@ class Recorder:
             worker, out = pending
             worker.join(wait)
             fields, note = out.get("result") or ({}, "archival analysis did not finish in time")
-        size = fields.pop("size_mm", None)
+        self._write_analysis(seq, fields, note)
+
+    def _write_analysis(self, seq, fields: dict, note: str):
+        """The analysis's columns, its archival size where it agreed with the wrist camera's
+        (the photo's scale, ~0.13 mm a pixel; the note keeps both), and its note; then the
+        image's sidecar. A value the catalogue refuses costs only that value."""
+        fields = dict(fields)
+        row = self.catalogue.get(self._id(seq))
+        size = fields.get("size_mm")
+        if size is not None and row.get("length_mm"):
+            note += "; wrist camera L %.1f mm, W %.1f mm" % (row["length_mm"], row["width_mm"])
         if fields:
             try:
-                self.catalogue.record_photo(
-                    self._id(seq),
-                    row["image_path"],
-                    row["image_sha256"],
-                    t_photo_s=row.get("t_photo_s"),
-                    **fields,
-                )
-            except FieldError as e:  # a value the catalogue refuses: the record without it
-                note = "; ".join(filter(None, [note, "archival values refused: %s" % e]))
-        if size is not None:
-            # the photo's length and width (the bar's scale, ~0.13 mm a pixel) replace the
-            # wrist camera's once the two agree; the note keeps both
-            try:
-                self.catalogue.record_dimensions(
-                    self._id(seq), size[0], size[1], row.get("thickness_mm")
-                )
-                if row.get("length_mm"):
-                    note += "; wrist camera L %.1f mm, W %.1f mm" % (
-                        row["length_mm"],
-                        row["width_mm"],
-                    )
+                self.catalogue.record_archival(self._id(seq), **fields)
             except FieldError as e:
-                note = "; ".join(filter(None, [note, "archival size refused: %s" % e]))
+                note = "; ".join(filter(None, [note, "archival values refused: %s" % e]))
+        # "archival:" marks the photo as analysed (see _analysed), even with nothing to say
+        self.catalogue.add_note(self._id(seq), "archival: " + (note or "analysed"))
         if note:
-            self.catalogue.add_note(self._id(seq), "archival: " + note)
             self.log("sherd %d archival: %s" % (seq, note))
+        if row["status"] in FINAL_STATUSES:
+            self.catalogue.refresh_sidecar(self._id(seq), self.archive)
 
     def done(self, seq, seconds: float = None, timings: dict = None):
-        self.finish_analysis(seq)
+        pending = self._pending.get(seq)
+        if pending is not None and not pending[0].is_alive():
+            self.finish_analysis(seq)  # finished already: in the row before the sidecar
         self.catalogue.record_done(
             self._id(seq), t_discard_s=seconds, timings=timings, archive=self.archive
         )
+        self.collect_analyses()
 
     def lost(self, seq, reason: str, timings: dict = None):
         if seq in self._pending:  # lost after its photo: the photo's colour is still its own

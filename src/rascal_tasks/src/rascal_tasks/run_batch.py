@@ -30,7 +30,7 @@ from rascal_tasks.catalogue.context_batches import (
 from rascal_tasks.catalogue.context_id import validate_context_id
 from rascal_tasks.catalogue.errors import CatalogueError
 from rascal_tasks.config import ConfigError, load_config
-from rascal_tasks.recorder import Recorder
+from rascal_tasks.recorder import ANALYSIS_WAIT, Recorder
 from rascal_tasks.rig import Rig, RigError
 from rascal_tasks.ros_config import load_for_run
 from rascal_tasks.ros_graph import GraphError, check_master, run_needs, wait_for_nodes
@@ -300,6 +300,9 @@ class Run:
                 continue
             break
         try:
+            # the photos' analyses still running (the arm never waited for them) and any done
+            # sherd of the context whose photo a stopped run left unanalysed
+            recorder.collect_analyses(wait=ANALYSIS_WAIT)
             rows = recorder.rows()
         except CatalogueError as e:
             rows = None

@@ -138,23 +138,7 @@ def analyse_rgb(
         r.mask = sherd.mask
 
     if corr is not None and sherd is not None:
-        lut = col.decode(np.arange(256))
-        linear = corr.apply(lut[rgb[sherd.mask > 0]])
-        full = np.zeros(rgb.shape, np.float64)
-        full[sherd.mask > 0] = linear
-        rgb_lin, n, why = sz.robust_colour(full, rgb, sherd.mask)
-        r.colour_px = n
-        if rgb_lin is None:
-            r.flags.append("no colour: %s" % why)
-        else:
-            chip, de = soil_chart().nearest(rgb_lin)
-            r.munsell, r.munsell_de00 = chip.notation, de
-            if de > MAX_CHIP_DE00:
-                r.flags.append(
-                    "colour off the soil chart: CIEDE2000 %.1f to %s" % (de, chip.notation)
-                )
-            lab = col.linear_to_lab_d50(rgb_lin)
-            r.lab_d50 = tuple(float(v) for v in np.clip(lab, [0, -200, -200], [100, 200, 200]))
+        colour_of(rgb, corr, sherd.mask, r)
 
     if sherd is not None and r.px_per_cm is not None:
         s = sz.mm_per_px(r.px_per_cm, geometry.camera_height_m, object_height_m)
@@ -169,6 +153,25 @@ def analyse_rgb(
                     % (r.length_mm, r.width_mm, wrist_size_mm[0], wrist_size_mm[1], tol)
                 )
     return r
+
+
+def colour_of(rgb: np.ndarray, corr: col.Correction, mask: np.ndarray, r: ArchivalResult):
+    """The robust colour of the sherd under `mask` (uint8) in the photo `rgb`, corrected by the
+    chart's `corr`, into `r`: Munsell chip, its distance, L*a*b* (D50), or a flag."""
+    lut = col.decode(np.arange(256))
+    full = np.zeros(rgb.shape, np.float64)
+    full[mask > 0] = corr.apply(lut[rgb[mask > 0]])
+    rgb_lin, n, why = sz.robust_colour(full, rgb, mask)
+    r.colour_px = n
+    if rgb_lin is None:
+        r.flags.append("no colour: %s" % why)
+        return
+    chip, de = soil_chart().nearest(rgb_lin)
+    r.munsell, r.munsell_de00 = chip.notation, de
+    if de > MAX_CHIP_DE00:
+        r.flags.append("colour off the soil chart: CIEDE2000 %.1f to %s" % (de, chip.notation))
+    lab = col.linear_to_lab_d50(rgb_lin)
+    r.lab_d50 = tuple(float(v) for v in np.clip(lab, [0, -200, -200], [100, 200, 200]))
 
 
 def chart_px_per_cm(chart: ch.Located, spec: ch.ChartSpec) -> float:

@@ -74,6 +74,12 @@ def find_sherd(
     c = max(contours, key=cv2.contourArea)
     mask = np.zeros_like(region)
     cv2.drawContours(mask, [c], -1, 255, thickness=cv2.FILLED)  # holes (paint, glare) filled
+    return region_of(mask)
+
+
+def region_of(mask: np.ndarray) -> SherdRegion:
+    """A sherd's mask (uint8, 0/255) measured: area, extents along and across its principal
+    axis [px]."""
     pts = np.argwhere(mask > 0)[:, ::-1].astype(np.float64)  # (x, y) of every pixel
     m = cv2.moments(mask, binaryImage=True)
     angle = 0.5 * np.arctan2(2 * m["mu11"], m["mu20"] - m["mu02"])

@@ -177,6 +177,22 @@ def wait_for_database(
         return result
 
 
+def _colour_fields(colour_munsell, colour_lab, chart_delta_e00, px_per_cm):
+    """The archival analysis's columns, checked (record_photo, record_archival)."""
+    f = {
+        "colour_munsell": check_munsell("colour_munsell", colour_munsell),
+        "chart_delta_e00": check_number("chart_delta_e00", chart_delta_e00, 0.0, 200.0),
+        "px_per_cm": check_number("px_per_cm", px_per_cm, 0.0, 1e5, "px/cm", lo_open=True),
+    }
+    if colour_lab is not None:
+        if not isinstance(colour_lab, (list, tuple)) or len(colour_lab) != 3:
+            raise FieldError("colour_lab %r: must be [L*, a*, b*] (D50)" % (colour_lab,))
+        f["colour_l"] = check_number("colour_lab[0] (L*)", colour_lab[0], 0.0, 100.0)
+        f["colour_a"] = check_number("colour_lab[1] (a*)", colour_lab[1], -200.0, 200.0)
+        f["colour_b"] = check_number("colour_lab[2] (b*)", colour_lab[2], -200.0, 200.0)
+    return f
+
+
 class Catalogue:
     """The sherd catalogue over one psycopg2 connection.
 
@@ -731,17 +747,9 @@ class Catalogue:
         f = {
             "image_path": check_text("image_path", image_path, 300, allow_none=False),
             "image_sha256": check_sha256("image_sha256", image_sha256),
-            "colour_munsell": check_munsell("colour_munsell", colour_munsell),
-            "chart_delta_e00": check_number("chart_delta_e00", chart_delta_e00, 0.0, 200.0),
-            "px_per_cm": check_number("px_per_cm", px_per_cm, 0.0, 1e5, "px/cm", lo_open=True),
             "t_photo_s": check_number("t_photo_s", t_photo_s, 0.0, 1e6, "s"),
         }
-        if colour_lab is not None:
-            if not isinstance(colour_lab, (list, tuple)) or len(colour_lab) != 3:
-                raise FieldError("colour_lab %r: must be [L*, a*, b*] (D50)" % (colour_lab,))
-            f["colour_l"] = check_number("colour_lab[0] (L*)", colour_lab[0], 0.0, 100.0)
-            f["colour_a"] = check_number("colour_lab[1] (a*)", colour_lab[1], -200.0, 200.0)
-            f["colour_b"] = check_number("colour_lab[2] (b*)", colour_lab[2], -200.0, 200.0)
+        f.update(_colour_fields(colour_munsell, colour_lab, chart_delta_e00, px_per_cm))
         if f["image_path"].startswith("/") or ".." in f["image_path"].split("/"):
             raise FieldError(
                 "image_path '%s': must be relative to the archive root, without "
@@ -776,6 +784,32 @@ class Catalogue:
         result = self.record_photo(sherd_id, rel, sha, **photo)
         self.refresh_sidecar(sherd_id, archive)  # the committed row (repaired at start if not)
         return result
+
+    def record_archival(
+        self,
+        sherd_id,
+        colour_munsell=None,
+        colour_lab=None,
+        chart_delta_e00=None,
+        px_per_cm=None,
+        size_mm=None,
+    ):
+        """What the archival photo's analysis measured, once it has finished: colour, the
+        chart's CIEDE2000, px/cm and (length, width) [mm] from the scale bar. A photographed
+        sherd, or one already done or lost after its photo (the analysis runs beside the
+        batch); no state change. Only the values given are written."""
+        f = _colour_fields(colour_munsell, colour_lab, chart_delta_e00, px_per_cm)
+        if size_mm is not None:
+            f["length_mm"] = check_number(
+                "length_mm", size_mm[0], 0.0, 2000.0, "mm", allow_none=False, lo_open=True
+            )
+            f["width_mm"] = check_number(
+                "width_mm", size_mm[1], 0.0, 2000.0, "mm", allow_none=False, lo_open=True
+            )
+        f = {k: v for k, v in f.items() if v is not None}
+        return self._advance(
+            sherd_id, "archival", ("photographed", "done", "lost"), f, None, dict(f)
+        )
 
     def record_done(self, sherd_id, t_discard_s=None, timings=None, archive=None):
         """The sherd is in the discard box; photographed -> done (final). ``timings`` is
