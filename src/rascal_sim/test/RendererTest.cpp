@@ -111,3 +111,36 @@ TEST(Renderer, NearerSurfaceHidesFartherOne) {
   EXPECT_NEAR(out.depth.at<float>(240, 320), 0.4, 1e-5);
   EXPECT_EQ(out.label.at<uint16_t>(240, 260), 1);
 }
+
+TEST(SensorEffects, ArchivalCameraVignettesTonesAndCompressesLikeACamera) {
+  rascal_sim::CameraModel cam;
+  cam.width = 600;
+  cam.height = 400;
+  cam.fx = cam.fy = 500.0;
+  cam.cx = 300.0;
+  cam.cy = 200.0;
+  cv::Mat flat(cam.height, cam.width, CV_8UC3, cv::Scalar(150, 150, 150));
+  cv::Mat img = flat.clone();
+  rascal_sim::SensorEffects::archivalCamera(img, cam);
+  ASSERT_EQ(img.size(), flat.size());
+  ASSERT_EQ(img.type(), CV_8UC3);
+  // the lens: a corner gets cos^4 of its field angle of the centre's light
+  const double t2 = (300.0 * 300.0 + 200.0 * 200.0) / (500.0 * 500.0);
+  const double expected = 1.0 / ((1.0 + t2) * (1.0 + t2));
+  const auto tone = [](double linear) {  // the picture style's S on the sRGB code
+    const double v = rascal_sim::Renderer::encodeSrgb(static_cast<float>(linear)) / 255.0;
+    return 255.0 * (v - rascal_sim::SensorEffects::kToneContrast * std::sin(2.0 * M_PI * v) / (2.0 * M_PI));
+  };
+  const double light = rascal_sim::Renderer::decodeSrgb(150);
+  EXPECT_NEAR(img.at<cv::Vec3b>(200, 300)[1], tone(light), 2.0);
+  EXPECT_NEAR(img.at<cv::Vec3b>(2, 2)[1], tone(light * expected), 3.0);
+  // the tone curve: a mid-grey stays (the S crosses at 0.5), darker greys get darker
+  cv::Mat greys(64, 64, CV_8UC3);
+  for (int x = 0; x < 64; ++x) greys.col(x).setTo(cv::Scalar::all(x < 32 ? 64 : 128));
+  cam.width = cam.height = 64;
+  cam.cx = cam.cy = 32.0;
+  cam.fx = cam.fy = 1e6;  // no vignetting
+  rascal_sim::SensorEffects::archivalCamera(greys, cam);
+  EXPECT_LT(greys.at<cv::Vec3b>(32, 8)[0], 60);
+  EXPECT_NEAR(greys.at<cv::Vec3b>(32, 56)[0], 128, 2);
+}

@@ -383,3 +383,44 @@ def test_archival_photo_without_a_photo_is_one_line_and_exit_2(tmp_path):
     )
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "does not exist" in r.stderr
+
+
+def _picture_style(rgb, contrast=0.15, quality=92):
+    """What a camera's JPEG engine does after the sensor: an S-shaped tone curve on the codes
+    (the simulator's, SensorEffects::archivalCamera) and JPEG compression."""
+    v = rgb / 255.0
+    v = v - contrast * np.sin(2 * np.pi * v) / (2 * np.pi)
+    out = np.clip(np.round(v * 255), 0, 255).astype(np.uint8)
+    ok, jpg = cv2.imencode(
+        ".jpg", cv2.cvtColor(out, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, quality]
+    )
+    return cv2.cvtColor(cv2.imdecode(jpg, cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
+
+
+@pytest.mark.parametrize(
+    "seed,chip,gains", [(61, "7.5YR 6/4", (1.1, 1.0, 0.8)), (62, "5YR 4/4", (0.9, 1.0, 1.1))]
+)
+def test_a_cameras_tone_curve_is_taken_out_by_the_grey_patches(seed, chip, gains):
+    rgb, truth = synthetic(seed, chip, gains, 0.9)
+    r = analyse_rgb(_picture_style(rgb))
+    assert r.chart_de00 is not None and r.chart_de00 < 1.2, r.flags
+    assert within_one_chip(soil_chart().chip(r.munsell), soil_chart().chip(chip)), r.munsell
+    # the matrix alone cannot undo an S-curve: the greys' curve is what brings the chart in
+    patches, clipped = chart.sample_patches(
+        rgb_styled := _picture_style(rgb), *_chart_of(rgb_styled)
+    )
+    assert col.fit(patches, clipped).mean_delta_e00 < _matrix_only(patches, clipped)
+
+
+def _chart_of(rgb):
+    loc = chart.locate("chart", chart.photo_features(rgb), chart.ChartSpec())
+    return loc, chart.ChartSpec()
+
+
+def _matrix_only(patches, clipped):
+    saved = col.LINEARISE
+    col.LINEARISE = False
+    try:
+        return col.fit(patches, clipped).mean_delta_e00
+    finally:
+        col.LINEARISE = saved

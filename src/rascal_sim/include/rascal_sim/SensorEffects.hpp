@@ -29,6 +29,12 @@ class SensorEffects {
   void colourImage(cv::Mat& colour, const cv::Mat& depth, const CameraModel& camera,
                    const Eigen::Isometry3d& world_T_camera, const Lighting& lighting, double t,
                    double blur_px);
+  /// What the archival camera (a DSLR writing JPEG) does after the light reached the sensor, in
+  /// place on its sRGB image: the lens's natural vignetting (cos^4 of the field angle), the
+  /// picture style's S-shaped tone curve, and JPEG compression (quality kJpegQuality).
+  static void archivalCamera(cv::Mat& srgb, const CameraModel& camera);
+  static constexpr double kToneContrast = 0.15;  ///< S-curve v - c sin(2 pi v) / 2 pi on codes
+  static constexpr int kJpegQuality = 92;         ///< a camera's "fine" JPEG
   /// CV_16UC1 depth in mm with noise, quantisation, min-Z holes and the left invalid band.
   cv::Mat depthImage(const cv::Mat& depth, const CameraModel& camera, bool left_band = true);
 

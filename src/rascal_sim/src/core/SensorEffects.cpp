@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "rascal_sim/Mesh.hpp"
@@ -119,6 +120,31 @@ void SensorEffects::colourImage(cv::Mat& img, const cv::Mat& depth, const Camera
       p[i] = static_cast<uint8_t>(v < 0 ? 0 : (v > 255 ? 255 : v));
     }
   }
+}
+
+void SensorEffects::archivalCamera(cv::Mat& img, const CameraModel& cam) {
+  // tone: code -> code after the S-curve (monotone: slope 1 - c cos(2 pi v) > 0)
+  uint8_t tone[256];
+  for (int i = 0; i < 256; ++i) {
+    const double v = i / 255.0;
+    const double t = v - kToneContrast * std::sin(2.0 * M_PI * v) / (2.0 * M_PI);
+    tone[i] = static_cast<uint8_t>(std::lround(255.0 * std::min(1.0, std::max(0.0, t))));
+  }
+  for (int y = 0; y < img.rows; ++y) {
+    cv::Vec3b* row = img.ptr<cv::Vec3b>(y);
+    const double ty = (y - cam.cy) / cam.fy;
+    for (int x = 0; x < img.cols; ++x) {
+      const double tx = (x - cam.cx) / cam.fx;
+      const double c2 = 1.0 / (1.0 + tx * tx + ty * ty);  // cos^2 of the field angle
+      const float falloff = static_cast<float>(c2 * c2);
+      for (int c = 0; c < 3; ++c) row[x][c] = tone[Renderer::encodeSrgb(Renderer::decodeSrgb(row[x][c]) * falloff)];
+    }
+  }
+  std::vector<uint8_t> jpeg;
+  cv::Mat bgr;
+  cv::cvtColor(img, bgr, cv::COLOR_RGB2BGR);  // the renderer's images are RGB
+  cv::imencode(".jpg", bgr, jpeg, {cv::IMWRITE_JPEG_QUALITY, kJpegQuality});
+  cv::cvtColor(cv::imdecode(jpeg, cv::IMREAD_COLOR), img, cv::COLOR_BGR2RGB);
 }
 
 cv::Mat SensorEffects::depthImage(const cv::Mat& depth, const CameraModel& cam, bool left_band) {

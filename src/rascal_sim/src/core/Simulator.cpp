@@ -229,6 +229,7 @@ cv::Mat Simulator::renderArchival() {
   RenderOutput out;
   renderer_.render(items_, archival_.model(), archival_.pose(), out, SensorEffects::lightGain(scenario_.lighting));
   effects_.colourImage(out.colour, out.depth, archival_.model(), archival_.pose(), scenario_.lighting, time(), 0.0);
+  SensorEffects::archivalCamera(out.colour, archival_.model());
   return out.colour;
 }
 

@@ -1,7 +1,8 @@
 """Colour correction of an archival photo from the 24 chart patches (colour-science).
 
-The photo's sRGB is decoded to linear RGB; a correction fitted from the patches' measured linear
-RGB to their published values (CIE L*a*b* D50 -> XYZ -> Bradford to D65 -> linear sRGB) maps
+The photo's sRGB is decoded to linear RGB; each channel's tone curve (what the camera's white
+balance, gamma and picture style did) is taken out with the six grey patches; a correction
+fitted from the patches' linearised RGB to their published values (CIE L*a*b* D50 -> XYZ -> Bradford to D65 -> linear sRGB) maps
 every pixel to linear sRGB under D65. Patches that clip (any channel at 0 or 255 over part of
 the patch) are left out of the fit. The chart's accuracy after correction is the mean CIEDE2000
 of the 24 patches against their published L*a*b* (D50). No ROS here.
@@ -46,6 +47,8 @@ C = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["C"]
 METHOD = "Cheung 2004"  # 3 x 3 matrix (terms=3): exact for a diagonal light and a linear camera
 TERMS = 3
 CLIP_SHARE = 0.02  # a patch with more than this share of clipped pixels is left out of the fit
+LINEARISE = os.environ.get("RASCAL_NO_TONE_CURVE") is None  # comparison runs only
+RESIDUAL = os.environ.get("RASCAL_NO_TONE_RESIDUAL") is None  # comparison runs only
 
 
 def decode(srgb8: np.ndarray) -> np.ndarray:
@@ -93,22 +96,66 @@ def delta_e00(lab1, lab2) -> np.ndarray:
     return colour.delta_E(lab1, lab2, method="CIE 2000")
 
 
+NEUTRALS = slice(18, 24)  # the chart's bottom row: white 9.5 ... black 2
+MIN_NEUTRALS = 4  # unclipped grey patches needed to fit the tone curve (else none is fitted)
+GAMMA_RANGE = (0.5, 2.0)  # a fitted exponent outside this is not a camera's: none is used
+
+
 @dataclass
 class Correction:
-    """A fitted correction: apply() maps linear camera RGB to linear sRGB (D65)."""
+    """A fitted correction: apply() maps linear camera RGB to linear sRGB (D65): first each
+    channel's tone curve (gain x value^gamma, from the grey patches), then the matrix."""
 
     matrix: np.ndarray  # the terms -> RGB matrix of colour-science's correction
     used: np.ndarray  # bool, 24: patches the fit used
     delta_e00: np.ndarray  # per patch, after correction (all 24)
+    gain: np.ndarray = None  # per channel (None: no tone curve)
+    gamma: np.ndarray = None
+    # per channel: the greys' log values and the power law's log residual there (the S of a
+    # picture style, interpolated between the greys, held beyond them)
+    knots: list = None
 
     @property
     def mean_delta_e00(self) -> float:
         return float(np.mean(self.delta_e00))
 
+    def linearise(self, linear: np.ndarray) -> np.ndarray:
+        if self.gain is None:
+            return linear
+        x = np.log(np.clip(linear, 1e-6, None))
+        out = self.gain * np.exp(self.gamma * x)
+        if self.knots is not None and RESIDUAL:
+            for c, (kx, ky) in enumerate(self.knots):
+                out[..., c] *= np.exp(np.interp(x[..., c], kx, ky))
+        return out
+
     def apply(self, linear: np.ndarray) -> np.ndarray:
         return colour.characterisation.apply_matrix_colour_correction(
-            linear, self.matrix, method=METHOD, terms=TERMS
+            self.linearise(linear), self.matrix, method=METHOD, terms=TERMS
         )
+
+
+def tone_curve(measured: np.ndarray, used: np.ndarray, ref: np.ndarray):
+    """(gain, gamma, knots) per channel mapping the grey patches' decoded values onto their
+    published linear values: a straight line in log-log (least squares; white balance and
+    gamma) and the greys' residuals from it, interpolated (a picture style's S-curve).
+    (None,) * 3 when too few greys are usable or the fit is no camera's; the matrix alone then
+    corrects."""
+    grey = np.zeros(len(measured), bool)
+    grey[NEUTRALS] = True
+    ok = grey & used & np.all(measured > 1e-3, axis=1)
+    if ok.sum() < MIN_NEUTRALS:
+        return None, None, None
+    gain, gamma, knots = np.ones(3), np.ones(3), []
+    for c in range(3):
+        x, y = np.log(measured[ok, c]), np.log(np.clip(ref[ok, c], 1e-4, None))
+        g, a = np.polyfit(x, y, 1)
+        if not GAMMA_RANGE[0] <= g <= GAMMA_RANGE[1] or np.any(np.diff(x[np.argsort(y)]) <= 0):
+            return None, None, None  # greys out of order: no camera's curve
+        gain[c], gamma[c] = np.exp(a), g
+        order = np.argsort(x)
+        knots.append((x[order], (y - (a + g * x))[order]))
+    return gain, gamma, knots
 
 
 def fit(patches_srgb8: np.ndarray, clipped_share: np.ndarray) -> Correction:
@@ -118,14 +165,13 @@ def fit(patches_srgb8: np.ndarray, clipped_share: np.ndarray) -> Correction:
     if used.sum() < 8:
         raise ValueError("colour chart: only %d of 24 patches unclipped, need 8" % used.sum())
     ref = reference_linear()
-    M = colour.characterisation.matrix_colour_correction(
-        measured[used], ref[used], method=METHOD, terms=TERMS
+    gain, gamma, knots = tone_curve(measured, used, ref) if LINEARISE else (None,) * 3
+    corr = Correction(np.eye(3), used, np.zeros(24), gain, gamma, knots)
+    corr.matrix = colour.characterisation.matrix_colour_correction(
+        corr.linearise(measured[used]), ref[used], method=METHOD, terms=TERMS
     )
-    corrected = colour.characterisation.apply_matrix_colour_correction(
-        measured, M, method=METHOD, terms=TERMS
-    )
-    de = delta_e00(linear_to_lab_d50(corrected), chart_reference_lab())
-    return Correction(M, used, de)
+    corr.delta_e00 = delta_e00(linear_to_lab_d50(corr.apply(measured)), chart_reference_lab())
+    return corr
 
 
 def correct_image(rgb8: np.ndarray, corr: Correction) -> np.ndarray:

@@ -1,0 +1,201 @@
+"""The physical bound of a station layout: the seconds one sherd takes at the arm's and the
+stations' limits, to set the measured seconds per sherd against (issue 18, item 2).
+
+Every move of the workflow's sequence (pickup, scale, archival camera with its standby, discard;
+approach, descent, lift at each) is timed as the synchronised trapezoid of its slowest joint at
+the servos' limits (facts/timing.md: pi rad/s, 5 rad/s^2) between joint vectors from the arm's
+own IK, with the wrist turned the least (yaw along the arm: a symmetric grasp); the gripper's
+strokes only as wide as the grasp margin; the stations' own times from the simulator's models
+(the scale's settling, the camera's shutter and transfer). Two figures:
+
+- `serial`: that sequence with every wait in series, as the workflow runs it today (the tare's
+  settle before placing, the whole capture with the arm at standby);
+- `bound`: the same moves with only what cannot overlap arm motion (the loaded scale settling
+  while the arm hovers, the shutter): no planner margin, no tare wait, no transfer wait.
+
+Pickup spots are averaged over a grid of the pickup area; the lawnmower survey is shared by the
+batch's sherds. No ROS in the core (`sequence`, `bound_of`); `main` asks /rascal/arm/compute_ik.
+"""
+
+import argparse
+import math
+import sys
+from dataclasses import dataclass
+from typing import Callable, Dict, List, Sequence, Tuple
+
+from rascal_tasks.config import Config
+from rascal_tasks.survey import CAMERA_OFFSET, lawnmower
+
+# facts/timing.md (the simulator enforces these; the servos' Velocity_Limit and the arm's
+# MoveIt acceleration limit)
+MAX_SPEED = math.pi  # [rad/s]
+MAX_ACCELERATION = 5.0  # [rad/s^2]
+# rascal_sim ScaleSensor (timing.md): first-order settling, readings every 0.1 s
+SCALE_TIME_CONSTANT = 0.3  # [s]
+SCALE_PERIOD = 0.1  # [s]
+# rascal_sim ArchivalCamera (timing.md): the arm stays out of view for the shutter
+SHUTTER = 0.2  # [s]
+TRANSFER = 1.5  # [s] image download after the shutter; the arm may move meanwhile
+# A representative sherd (facts/sherds_and_colour.md: 20-70 mm, 5-60 g): its mass sets the
+# scale's settling, its grasp height the descents.
+TYPICAL_MASS = 0.02  # [kg]
+GRASP_HEIGHT = 0.008  # [m] ee_gripper_link above the surface when closing
+PICKUP_GRID = (5, 3)  # pickup spots averaged over, along x and y
+
+
+def trapezoid(distance: float, speed: float = MAX_SPEED, acc: float = MAX_ACCELERATION) -> float:
+    """Least time to travel `distance` [rad] from rest to rest within `speed` and `acc`."""
+    d = abs(distance)
+    if d <= speed * speed / acc:
+        return 2.0 * math.sqrt(d / acc)
+    return d / speed + speed / acc
+
+
+def move_time(q0: Sequence[float], q1: Sequence[float]) -> float:
+    """A joint move synchronised to its slowest joint."""
+    return max(trapezoid(b - a) for a, b in zip(q0, q1, strict=True))
+
+
+def scale_settle(mass: float, window: float, readability: float) -> float:
+    """Seconds from a load landing until a whole `window` of readings stays within
+    `readability`: the first-order approach's change over the window falls below it."""
+    decay = 1.0 - math.exp(-window / SCALE_TIME_CONSTANT)
+    t = SCALE_TIME_CONSTANT * math.log(max(1.0, mass * decay / readability))
+    return math.ceil((t + window) / SCALE_PERIOD) * SCALE_PERIOD
+
+
+@dataclass
+class Step:
+    what: str
+    pose: Tuple[float, float, float]  # x, y, z of ee_gripper_link [m]
+    wait: float = 0.0  # [s] after arriving (gripper stroke, station) in the bound
+    serial_wait: float = 0.0  # [s] more, in series, as the workflow runs today
+
+
+def sequence(cfg: Config, pickup_xy: Tuple[float, float]) -> List[Step]:
+    """The moves and waits of one sherd picked at `pickup_xy`, from the discard drop of the
+    sherd before to its own (the workflow's order: stations in config order)."""
+    arm, scale = cfg["arm"], cfg["scale"]
+    margin_stroke = arm["gripper"]["stroke_time"] * arm["grasp_margin"] / 0.044  # of 30..74 mm
+    travel, approach = arm["travel_z"], arm["approach_offset"]
+    steps: List[Step] = []
+    px, py = pickup_xy
+    z0 = cfg.stations["pickup"].surface_z + GRASP_HEIGHT
+    steps += [
+        Step("approach pickup", (px, py, z0 + approach), wait=margin_stroke),  # open on the way
+        Step("descend", (px, py, z0), wait=margin_stroke),  # close
+        Step("lift", (px, py, travel)),
+    ]
+    for name in cfg.station_order():
+        st = cfg.stations[name]
+        x, y = st.place_at
+        if st.type == "discard":
+            steps.append(Step("over discard", (x, y, travel), wait=margin_stroke))  # let go
+            continue
+        z = st.surface_z + GRASP_HEIGHT + arm["place_clearance"]
+        if st.type == "scale":
+            # today the tare waits a stable window before the sherd is placed
+            steps.append(Step("over scale", (x, y, travel), serial_wait=scale["stable_window"]))
+            steps.append(Step("place on scale", (x, y, z), wait=margin_stroke))
+            steps.append(Step("hover", (x, y, z + approach)))
+            settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
+            steps.append(Step("settled; descend", (x, y, z), wait=margin_stroke))
+            steps[-2].wait = settle  # the arm hovers while the load settles
+        else:
+            steps.append(Step("over " + name, (x, y, travel)))
+            steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke))
+            steps.append(Step("lift", (x, y, travel)))
+            if st.type == "archival_camera":
+                sx, sy = arm["standby"]
+                steps.append(Step("standby", (sx, sy, travel), wait=SHUTTER, serial_wait=TRANSFER))
+                steps.append(Step("over " + name, (x, y, travel)))
+            steps.append(Step("descend", (x, y, z), wait=margin_stroke))
+        steps.append(Step("lift", (x, y, travel)))
+    return steps
+
+
+def survey_steps(cfg: Config) -> List[Step]:
+    st, sv = cfg.stations["pickup"], cfg["survey"]
+    out = []
+    for x, y in lawnmower(st.area.center, st.area.size, sv["step"]):
+        yaw = math.atan2(y, x)
+        ex, ey = x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw)
+        out.append(Step("survey", (ex, ey, st.surface_z + sv["z"]), wait=sv["settle_time"]))
+    return out
+
+
+def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, list]:
+    """(motion, bound waits, serial waits, last joints) of `steps` from the joints `start`."""
+    q, motion, waits, serial = start, 0.0, 0.0, 0.0
+    for s in steps:
+        q1 = ik(*s.pose, q)
+        motion += move_time(q, q1)
+        waits += s.wait
+        serial += s.serial_wait
+        q = q1
+    return motion, waits, serial, q
+
+
+def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str, float]:
+    """Seconds per sherd at the limits, averaged over the pickup grid. `ik(x, y, z, seed)` ->
+    joints of ee_gripper_link pointing down at (x, y, z), yaw along the arm."""
+    st = cfg.stations["pickup"]
+    (cx, cy), (sx, sy) = st.area.center, st.area.size
+    nx, ny = PICKUP_GRID
+    spots = [
+        (cx - sx / 2 + (i + 0.5) * sx / nx, cy - sy / 2 + (j + 0.5) * sy / ny)
+        for i in range(nx)
+        for j in range(ny)
+    ]
+    dx, dy = cfg.stations["discard"].place_at
+    home = ik(dx, dy, cfg["arm"]["travel_z"], None)
+    totals = {"motion": 0.0, "waits": 0.0, "serial_waits": 0.0}
+    for spot in spots:
+        m, w, s, _ = timed(sequence(cfg, spot), ik, home)
+        totals["motion"] += m / len(spots)
+        totals["waits"] += w / len(spots)
+        totals["serial_waits"] += s / len(spots)
+    m, w, _, q = timed(survey_steps(cfg), ik, home)
+    m += move_time(q, home)
+    totals["survey"] = (m + w) / max(1, sherds_per_survey)
+    totals["bound"] = totals["motion"] + totals["waits"] + totals["survey"]
+    totals["serial"] = totals["bound"] + totals["serial_waits"]
+    return totals
+
+
+def main(argv=None) -> int:
+    """`python3 -m rascal_tasks.layout_bound [--config FILE] [--sherds N]` with the arm
+    controller running (its IK)."""
+    import rospy
+    from rascal_control import Arm as ControlArm
+    from rascal_msgs.srv import ComputeIK
+
+    from rascal_tasks.ros_config import load_from_param_server
+
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--config", help="a config file (default: the parameter server's)")
+    p.add_argument("--sherds", type=int, default=10, help="sherds sharing one survey")
+    args = p.parse_args(argv)
+    rospy.init_node("layout_bound", anonymous=True)
+    if args.config:
+        from rascal_tasks.config import load_config
+
+        cfg = load_config(args.config)
+    else:
+        cfg = load_from_param_server()
+    rospy.wait_for_service("/rascal/arm/compute_ik", 10.0)
+    solve = rospy.ServiceProxy("/rascal/arm/compute_ik", ComputeIK)
+
+    def ik(x, y, z, seed):
+        r = solve(ControlArm.top_down(x, y, z, math.atan2(y, x)), list(seed or []))
+        if r.code != 0:
+            raise SystemExit("layout_bound: (%.3f, %.3f, %.3f) m: %s" % (x, y, z, r.message))
+        return list(r.joints)
+
+    t = bound_of(cfg, ik, args.sherds)
+    print(" ".join("%s=%.2f" % kv for kv in sorted(t.items())))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

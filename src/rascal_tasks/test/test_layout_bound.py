@@ -1,0 +1,52 @@
+"""The layout's physical bound (layout_bound.py) on its own: trapezoids at the servo limits, the
+scale's settling, and the bound of the site's layout with a stand-in IK (a top-down arm in
+cylindrical coordinates: the waist turns to the spot, the other joints follow reach and height)."""
+
+import copy
+import math
+import os
+
+import pytest
+import yaml
+
+from rascal_tasks import layout_bound as lb
+from rascal_tasks.config import config_from_dict
+
+WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+
+
+@pytest.fixture
+def data():
+    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
+        return yaml.safe_load(f)
+
+
+def ik(x, y, z, seed):
+    r = math.hypot(x, y)
+    return [math.atan2(y, x), 4.0 * (r - 0.3), -4.0 * (r - 0.3) + 3.0 * z, 0.0, 3.0 * z, 0.0]
+
+
+def test_trapezoid_at_the_servo_limits():
+    # short: triangular, 2 sqrt(d/a); long: cruise at pi rad/s
+    assert lb.trapezoid(0.5) == pytest.approx(2 * math.sqrt(0.5 / 5.0))
+    assert lb.trapezoid(-3.0) == pytest.approx(3.0 / math.pi + math.pi / 5.0)
+    assert lb.trapezoid(0.0) == 0.0
+    assert lb.move_time([0, 0, 0], [0.1, -2.0, 0.3]) == pytest.approx(lb.trapezoid(2.0))
+
+
+def test_the_scale_settles_later_for_heavier_sherds_and_longer_windows():
+    light = lb.scale_settle(0.005, 1.0, 1e-4)
+    heavy = lb.scale_settle(0.060, 1.0, 1e-4)
+    assert 1.0 < light < heavy < 4.0
+    assert lb.scale_settle(0.02, 0.5, 1e-4) < lb.scale_settle(0.02, 1.0, 1e-4)
+
+
+def test_the_bound_is_below_the_serial_sequence_and_grows_with_the_layout(data):
+    near = lb.bound_of(config_from_dict(data), ik)
+    assert 0 < near["bound"] < near["serial"]
+    assert near["serial"] - near["bound"] == pytest.approx(
+        data["scale"]["stable_window"] + lb.TRANSFER
+    )
+    far = copy.deepcopy(data)
+    far["stations"]["discard"]["position"] = [-0.05, -0.38]  # the box farther round
+    assert lb.bound_of(config_from_dict(far), ik)["motion"] > near["motion"]
