@@ -81,36 +81,15 @@ def analyse_rgb(
     geometry = geometry if geometry is not None else Geometry()
     r = ArchivalResult()
     feats = ch.photo_features(rgb)
-    chart = bar = None
-    try:
-        chart = ch.locate("chart", feats, geometry.chart)
-        r.chart_reprojection_px = chart.reprojection_px
-        if chart.reprojection_px > MAX_REPROJECTION_PX:
-            r.flags.append("colour chart fit %.1f px RMS" % chart.reprojection_px)
-    except ch.TargetNotFound as e:
-        r.flags.append("no colour: %s" % e)
+    chart, corr = chart_correction(rgb, feats, geometry.chart, r)
+    if corr is not None:
+        r.corrected = col.correct_image(rgb, corr)
     bar = _find_bar(rgb, feats, geometry, chart, r)
     if bar is not None:
         r.bar_reprojection_px = bar.reprojection_px
         r.px_per_cm = ch.bar_px_per_cm(bar, geometry.bar)
         if bar.reprojection_px > MAX_REPROJECTION_PX:
             r.flags.append("scale bar fit %.1f px RMS" % bar.reprojection_px)
-
-    corr = None
-    if chart is not None:
-        try:
-            patches, clipped = ch.sample_patches(rgb, chart, geometry.chart)
-            corr = col.fit(patches, clipped)
-            r.chart_de00 = corr.mean_delta_e00
-            if r.chart_de00 > MAX_CHART_DE00:
-                r.flags.append(
-                    "colour uncertain: chart CIEDE2000 %.1f after correction (> %.1f)"
-                    % (r.chart_de00, MAX_CHART_DE00)
-                )
-            r.corrected = col.correct_image(rgb, corr)
-        except (ValueError, np.linalg.LinAlgError) as e:
-            r.flags.append("no colour: %s" % e)
-            corr = None
 
     exclude = np.zeros(rgb.shape[:2], np.uint8)
     for loc in (chart, bar):
@@ -153,6 +132,33 @@ def analyse_rgb(
                     % (r.length_mm, r.width_mm, wrist_size_mm[0], wrist_size_mm[1], tol)
                 )
     return r
+
+
+def chart_correction(rgb: np.ndarray, feats, spec: ch.ChartSpec, r: ArchivalResult):
+    """(the chart located, the colour correction fitted from it), either None where it failed;
+    what went wrong or is doubtful is flagged in `r`, with the chart's reprojection error and
+    CIEDE2000 after correction."""
+    try:
+        chart = ch.locate("chart", feats, spec)
+    except ch.TargetNotFound as e:
+        r.flags.append("no colour: %s" % e)
+        return None, None
+    r.chart_reprojection_px = chart.reprojection_px
+    if chart.reprojection_px > MAX_REPROJECTION_PX:
+        r.flags.append("colour chart fit %.1f px RMS" % chart.reprojection_px)
+    try:
+        patches, clipped = ch.sample_patches(rgb, chart, spec)
+        corr = col.fit(patches, clipped)
+    except (ValueError, np.linalg.LinAlgError) as e:
+        r.flags.append("no colour: %s" % e)
+        return chart, None
+    r.chart_de00 = corr.mean_delta_e00
+    if r.chart_de00 > MAX_CHART_DE00:
+        r.flags.append(
+            "colour uncertain: chart CIEDE2000 %.1f after correction (> %.1f)"
+            % (r.chart_de00, MAX_CHART_DE00)
+        )
+    return chart, corr
 
 
 def colour_of(rgb: np.ndarray, corr: col.Correction, mask: np.ndarray, r: ArchivalResult):

@@ -2,10 +2,11 @@
 
 The photo's sRGB is decoded to linear RGB; each channel's tone curve (what the camera's white
 balance, gamma and picture style did) is taken out with the six grey patches; a correction
-fitted from the patches' linearised RGB to their published values (CIE L*a*b* D50 -> XYZ -> Bradford to D65 -> linear sRGB) maps
-every pixel to linear sRGB under D65. Patches that clip (any channel at 0 or 255 over part of
-the patch) are left out of the fit. The chart's accuracy after correction is the mean CIEDE2000
-of the 24 patches against their published L*a*b* (D50). No ROS here.
+fitted from the patches' linearised RGB to their published values (CIE L*a*b* D50 -> XYZ ->
+Bradford to D65 -> linear sRGB) maps every pixel to linear sRGB under D65. Patches that clip
+(any channel at 0 or 255 over part of the patch) are left out of the fit. The chart's accuracy
+after correction is the mean CIEDE2000 of the 24 patches against their published L*a*b* (D50).
+No ROS here.
 """
 
 import glob

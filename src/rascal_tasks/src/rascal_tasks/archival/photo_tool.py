@@ -24,10 +24,10 @@ from rascal_tasks.archival import chart as ch
 from rascal_tasks.archival import colour as col
 from rascal_tasks.archival import size as sz
 from rascal_tasks.archival.analysis import (
-    MAX_CHART_DE00,
     ArchivalResult,
-    _find_bar,
     Geometry,
+    _find_bar,
+    chart_correction,
     colour_of,
     read_rgb,
 )
@@ -96,24 +96,7 @@ def analyse_photo(photo: str) -> dict:
     geometry = Geometry()
     photo_r = ArchivalResult()
     feats = ch.photo_features(rgb)
-    chart = corr = None
-    try:
-        chart = ch.locate("chart", feats, geometry.chart)
-        photo_r.chart_reprojection_px = chart.reprojection_px
-    except ch.TargetNotFound as e:
-        photo_r.flags.append("no colour: %s" % e)
-    if chart is not None:
-        try:
-            patches, clipped = ch.sample_patches(rgb, chart, geometry.chart)
-            corr = col.fit(patches, clipped)
-            photo_r.chart_de00 = corr.mean_delta_e00
-            if corr.mean_delta_e00 > MAX_CHART_DE00:
-                photo_r.flags.append(
-                    "colour uncertain: chart CIEDE2000 %.1f after correction (> %.1f)"
-                    % (corr.mean_delta_e00, MAX_CHART_DE00)
-                )
-        except (ValueError, np.linalg.LinAlgError) as e:
-            photo_r.flags.append("no colour: %s" % e)
+    chart, corr = chart_correction(rgb, feats, geometry.chart, photo_r)
     bar = None
     if seg.get("px_per_cm") is None:  # the archival station's bar, when segment_image saw none
         bar = _find_bar(rgb, feats, geometry, chart, photo_r)
