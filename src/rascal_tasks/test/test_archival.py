@@ -424,3 +424,41 @@ def _matrix_only(patches, clipped):
         return col.fit(patches, clipped).mean_delta_e00
     finally:
         col.LINEARISE = saved
+
+
+def test_the_end_of_a_batch_catches_up_only_its_own_photos_and_only_till_its_deadline(
+    catalogue, migrated_dsn, tmp_path
+):
+    """Done sherds whose photo was never analysed (recorded before photos were analysed, or a
+    run stopped in between) are analysed at the end of a batch: this rig's only, and only while
+    the deadline lasts, so an old context never holds the batch's end for minutes."""
+    import time
+
+    from rascal_tasks.catalogue import Catalogue, ImageArchive
+    from rascal_tasks.recorder import Recorder
+
+    archive = ImageArchive(str(tmp_path / "archive"))
+    other = Catalogue.connect(migrated_dsn, rig="rig-b", config_hash="cafe0123")
+    capture = tmp_path / "capture.png"
+    for cat in (other, catalogue, catalogue, catalogue, catalogue):
+        rec = Recorder(cat, archive, "C", "site")
+        rec.analyse_photos = False  # recorded without analysis
+        seq = rec.new_sherd((0.1, 0.2))
+        rec.mass(seq, 0.02)
+        cv2.imwrite(str(capture), np.full((60, 80, 3), 90, np.uint8))
+        rec.photo(seq, str(capture))
+        rec.done(seq)
+    other.close()
+    rec = Recorder(catalogue, archive, "C", "site")
+    analysed = []
+    rec._analyse = lambda path, wrist: (time.sleep(0.4), analysed.append(path), ({}, "x"))[2]
+    rec.collect_analyses(wait=1.0)
+    assert 2 <= len(analysed) <= 3  # 0.4 s each within the 1 s deadline, rig-b's never
+    rows = {r["seq"]: r for r in catalogue.sherds("C")}
+    assert "archival:" not in (rows[1]["notes"] or "")  # rig-b's photo left to rig-b
+    rec.collect_analyses(wait=10.0)  # the rest at the next batch's end, none twice
+    assert len(analysed) == 4
+    assert all(
+        (rows_notes or "").count("archival: ") == 1
+        for rows_notes in [r["notes"] for r in catalogue.sherds("C") if r["seq"] > 1]
+    )

@@ -209,9 +209,10 @@ class Recorder:
 
     def collect_analyses(self, wait: float = 0.0):
         """Record every photo analysis that has finished; with `wait` > 0, wait up to `wait` s
-        in all for those still running (the end of a batch), and look for done sherds of the
-        context whose photo was never analysed (a run that stopped in between): they are
-        analysed now. What did not finish in time is noted, never lost silently."""
+        in all for those still running (the end of a batch), and look for this rig's done sherds
+        of the context whose photo was never analysed (a run that stopped in between): they are
+        analysed now, as long as the deadline lasts. What did not finish in time is noted,
+        never lost silently."""
         deadline = time.monotonic() + wait
         for seq in sorted(self._pending):
             worker, out = self._pending[seq]
@@ -222,9 +223,15 @@ class Recorder:
             del self._pending[seq]
             fields, note = out.get("result") or ({}, "archival analysis did not finish in time")
             self._write_analysis(seq, fields, note)
-        if wait > 0:
+        if wait > 0 and self.analyse_photos:
+            # this rig's own photos only, and only while the deadline lasts (a context recorded
+            # before photos were analysed is caught up over the next batches, not at once)
             for row in self.catalogue.sherds(self.context, ("done",)):
-                if row.get("image_path") and not _analysed(row):
+                if time.monotonic() >= deadline:
+                    break
+                if row.get("rig") != self.catalogue.rig or not row.get("image_path"):
+                    continue
+                if not _analysed(row):
                     self._ids[row["seq"]] = row["sherd_id"]
                     fields, note = self._analyse(
                         self.archive.path(row["image_path"]), self._wrist_size(row["seq"])

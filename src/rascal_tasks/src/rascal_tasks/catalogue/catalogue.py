@@ -943,6 +943,11 @@ class Catalogue:
             return [r["context_id"] for r in cur.fetchall()]
 
     # --- identity and the archive ---
+    @property
+    def rig(self) -> str:
+        """The rig this catalogue records for (its rows' `rig`)."""
+        return self._rig
+
     def identity(self):
         """This catalogue's UUID (table catalogue_identity, migration 0004), read once. The
         archive names files with it, so two catalogues never write the same file. A copy of
