@@ -31,6 +31,8 @@ import xmlrpc.client
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
+from rascal_workcell.processes import free_port, stop, workspace
+
 FAULT = 3
 SIM_NS = "/emulated"
 SIM_REMAPS = (
@@ -60,21 +62,6 @@ class Started:
     node: Node
     proc: subprocess.Popen
     log: str
-
-
-def workspace() -> str:
-    here = os.path.dirname(os.path.abspath(__file__))
-    for up in range(2, 6):
-        root = os.path.abspath(os.path.join(here, *([".."] * up)))
-        if os.path.isfile(os.path.join(root, "config", "rascal.yaml")):
-            return root
-    return os.getcwd()
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def field_nodes() -> List[Node]:
@@ -157,21 +144,6 @@ def task_nodes() -> List[Node]:
             "is rascal_perception built?",
         ),
     ]
-
-
-def stop(proc: subprocess.Popen, timeout: float = 10.0) -> None:
-    """Ctrl-C to the process group, then SIGKILL what is left."""
-    if proc.poll() is not None:
-        return
-    try:
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(timeout=timeout)
-    except (subprocess.TimeoutExpired, ProcessLookupError):
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-        proc.wait()
 
 
 def last_line(path: str) -> str:

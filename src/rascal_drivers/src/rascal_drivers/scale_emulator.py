@@ -11,13 +11,13 @@ garbage. No ROS here.
 import os
 import random
 import select
-import threading
 import time
-import tty
 from typing import Optional
 
+from rascal_drivers.pty_device import PtyDevice
 
-class ScaleEmulator:
+
+class ScaleEmulator(PtyDevice):
     def __init__(
         self,
         protocol: str,
@@ -44,34 +44,7 @@ class ScaleEmulator:
         self.garbage_next = 0  # the next N replies are line noise
         self.commands = []
         self._within_since = time.monotonic()
-        self.master, self._slave = os.openpty()
-        tty.setraw(self._slave)
-        self.device = os.ttyname(self._slave)
-        self.link = link
-        if link:
-            if os.path.lexists(link):
-                os.unlink(link)
-            os.symlink(self.device, link)
-        self.lock = threading.Lock()
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-
-    def start(self) -> "ScaleEmulator":
-        self._thread.start()
-        return self
-
-    def stop(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=2.0)
-        for fd in (self.master, self._slave):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
-        if self.link and os.path.islink(self.link):
-            os.unlink(self.link)
-
-    unplug = stop  # the cable pulled: the line disappears under the driver
+        super().__init__(link)
 
     def put(self, mass: float) -> None:
         with self.lock:

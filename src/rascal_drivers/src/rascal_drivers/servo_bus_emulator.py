@@ -12,13 +12,12 @@ hardware errors, a rigid object between the fingers, garbage bytes and unpluggin
 import os
 import select
 import struct
-import threading
 import time
-import tty
 from typing import Dict, List, Optional
 
 from rascal_drivers import control_table as ct
 from rascal_drivers import protocol2 as p2
+from rascal_drivers.pty_device import PtyDevice
 
 TIME_CONSTANT = 0.05  # [s] first-order lag of the emulated position loop
 MAX_STEP = 0.01  # [s] a starved emulator thread moves its servos late, never in a jump
@@ -148,55 +147,17 @@ class EmulatedServo:
         self.saturated_for = 0.0
 
 
-class ServoBusEmulator:
+class ServoBusEmulator(PtyDevice):
     """Servos on one bus behind a pty; `device` is the path a driver opens."""
 
     def __init__(self, servos: List[EmulatedServo], link: Optional[str] = None):
         self.servos: Dict[int, EmulatedServo] = {s.dxl_id: s for s in servos}
-        self.master, slave = os.openpty()
-        tty.setraw(slave)
-        self._slave = slave  # kept open so the line stays up between driver sessions
-        self.device = os.ttyname(slave)
-        self.link = link
-        if link:
-            if os.path.lexists(link):
-                os.unlink(link)
-            os.symlink(self.device, link)
-        self.lock = threading.Lock()
         # the clock the servos move on: the wall clock, or the simulator's (the emulated rig,
         # so a servo moves exactly as far as the simulated time the driver stamps it with)
         self.clock = time.monotonic
         self.packets = 0
         self.crc_errors = 0
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-
-    def start(self) -> "ServoBusEmulator":
-        self._thread.start()
-        return self
-
-    def stop(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=2.0)
-        for fd in (self.master, self._slave):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
-        if self.link and os.path.islink(self.link):
-            os.unlink(self.link)
-
-    def unplug(self) -> None:
-        """The U2D2 pulled out: the line goes away under the driver."""
-        self._stop.set()
-        self._thread.join(timeout=2.0)
-        for fd in (self.master, self._slave):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
-        if self.link and os.path.islink(self.link):
-            os.unlink(self.link)
+        super().__init__(link)
 
     def send_garbage(self, data: bytes) -> None:
         os.write(self.master, data)

@@ -14,12 +14,11 @@ strokes only as wide as the grasp margin; the stations' own times from the simul
   while the arm hovers, the shutter): no planner margin, no tare wait, no transfer wait.
 
 Pickup spots are averaged over a grid of the pickup area; the lawnmower survey is shared by the
-batch's sherds. No ROS in the core (`sequence`, `bound_of`); `main` asks /rascal/arm/compute_ik.
+batch's sherds. No ROS here: `rosrun rascal_tasks layout_bound` (scripts/) gives `bound_of` the
+arm controller's IK.
 """
 
-import argparse
 import math
-import sys
 from dataclasses import dataclass
 from typing import Callable, Dict, List, Sequence, Tuple
 
@@ -161,41 +160,3 @@ def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str
     totals["bound"] = totals["motion"] + totals["waits"] + totals["survey"]
     totals["serial"] = totals["bound"] + totals["serial_waits"]
     return totals
-
-
-def main(argv=None) -> int:
-    """`python3 -m rascal_tasks.layout_bound [--config FILE] [--sherds N]` with the arm
-    controller running (its IK)."""
-    import rospy
-    from rascal_control import Arm as ControlArm
-    from rascal_msgs.srv import ComputeIK
-
-    from rascal_tasks.ros_config import load_from_param_server
-
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--config", help="a config file (default: the parameter server's)")
-    p.add_argument("--sherds", type=int, default=10, help="sherds sharing one survey")
-    args = p.parse_args(argv)
-    rospy.init_node("layout_bound", anonymous=True)
-    if args.config:
-        from rascal_tasks.config import load_config
-
-        cfg = load_config(args.config)
-    else:
-        cfg = load_from_param_server()
-    rospy.wait_for_service("/rascal/arm/compute_ik", 10.0)
-    solve = rospy.ServiceProxy("/rascal/arm/compute_ik", ComputeIK)
-
-    def ik(x, y, z, seed):
-        r = solve(ControlArm.top_down(x, y, z, math.atan2(y, x)), list(seed or []))
-        if r.code != 0:
-            raise SystemExit("layout_bound: (%.3f, %.3f, %.3f) m: %s" % (x, y, z, r.message))
-        return list(r.joints)
-
-    t = bound_of(cfg, ik, args.sherds)
-    print(" ".join("%s=%.2f" % kv for kv in sorted(t.items())))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

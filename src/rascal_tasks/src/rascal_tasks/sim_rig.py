@@ -9,14 +9,13 @@ simulator, the arm controller and the detector; and it stops all of them again.
 import argparse
 import os
 import shutil
-import signal
-import socket
 import subprocess
 import sys
 import tempfile
 import time
 
 import yaml
+from rascal_workcell.processes import free_port, stop, workspace
 
 NODES = (
     ("rascal_sim", "sim"),
@@ -24,36 +23,6 @@ NODES = (
     ("rascal_perception", "sherd_detector"),
 )
 READY = ("/sim/ground_truth", "/rascal/arm/compute_ik", "/rascal/perception/detect")
-
-
-def workspace() -> str:
-    here = os.path.dirname(os.path.abspath(__file__))
-    for up in range(2, 6):  # devel space or source tree
-        root = os.path.abspath(os.path.join(here, *([".."] * up)))
-        if os.path.isfile(os.path.join(root, "config", "rascal.yaml")):
-            return root
-    return os.getcwd()
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def stop(proc, timeout=10.0):
-    """Ctrl-C to the process group, then SIGKILL what is left."""
-    if proc.poll() is not None:
-        return
-    try:
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(timeout=timeout)
-    except (subprocess.TimeoutExpired, ProcessLookupError):
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-        proc.wait()
 
 
 class RosMaster:
