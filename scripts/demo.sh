@@ -44,4 +44,8 @@ mkdir -p var/exports var/backups
   rosrun rascal_tasks rascal run --context '$context' &&
   rosrun rascal_tasks rascal report --context '$context' --pdf &&
   rosrun rascal_tasks rascal export --context '$context' --format field-desktop --output 'var/exports/$context' &&
-  rosrun rascal_tasks rascal backup --output 'var/backups/$context.backup'"
+  { rosrun rascal_tasks rascal backup --output 'var/backups/$context.backup'; rc=\$?;
+    # 1: written, but rows of the catalogue name images this archive does not hold (contexts
+    # recorded from another checkout into the same database): said above, one line each
+    if [ \$rc -eq 1 ]; then echo 'demo: backup written; the images listed above are not in this archive'; fi
+    [ \$rc -le 1 ]; }"
