@@ -33,12 +33,12 @@ def segment(*args, cwd=None):
 
 @functools.lru_cache(maxsize=None)
 def photo_result(photo):
-    """The tool's JSON for one photo of the data set (run once per photo)."""
+    """The tool's report (JSON object) for one photo of the data set (run once per photo)."""
     return result(photo)[0]
 
 
 def result(photo, *args, cwd=None):
-    r = segment(photo, "--json", "-", "--no-overlay", *args, cwd=cwd)
+    r = segment(photo, "--report", "-", "--no-overlay", *args, cwd=cwd)
     assert r.returncode in (0, 1), r.stderr
     return json.loads(r.stdout), r
 
@@ -82,28 +82,48 @@ def test_scale_within_two_percent_of_the_hand_reading(name):
 
 def test_options_before_or_after_the_photo_give_the_same_result(tmp_path):
     photo = os.path.join(PHOTOS, "img114SG101831.jpg")
-    a = segment("--json", str(tmp_path / "a.json"), "--no-overlay", photo)
-    b = segment(photo, "--no-overlay", "--json", str(tmp_path / "b.json"))
+    a = segment("--json", str(tmp_path / "a.json"), "--format", "table", "--no-overlay", photo)
+    b = segment(photo, "--no-overlay", "--format", "table", "--json", str(tmp_path / "b.json"))
     assert a.returncode == b.returncode and a.stdout == b.stdout
     assert json.loads((tmp_path / "a.json").read_text()) == json.loads(
         (tmp_path / "b.json").read_text()
     )
-    assert "length mm" in a.stdout.splitlines()[0]  # the table by default
+    assert "length mm" in a.stdout.splitlines()[0]
 
 
 @pytest.mark.parametrize(
     "args",
-    [["{p}", "--json"], ["--json", "{p}"], ["--format", "json", "{p}"], ["{p}", "--json", "-"]],
-    ids=["json-last", "json-first", "format-json", "json-dash"],
+    [
+        ["{p}", "--json"],
+        ["--json", "{p}"],
+        ["--format", "json", "{p}"],
+        ["{p}", "--json", "-"],
+        ["-j", "{p}"],
+        ["{p}"],  # stdout is a pipe here: a program reads it, so JSON by default
+    ],
+    ids=["json-last", "json-first", "format-json", "json-dash", "j", "piped"],
 )
-def test_json_on_stdout_is_the_whole_output_however_asked(tmp_path, args):
+def test_json_on_stdout_is_one_list_of_sherds_however_asked(tmp_path, args):
     photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
     r = segment(*[a.format(p=photo) for a in args], "--no-overlay", cwd=tmp_path)
     assert r.returncode in (0, 1), r.stderr
-    d = json.loads(r.stdout)  # nothing but the JSON, even with stderr merged in
-    assert r.stderr == "" and d["sherd_count"] == len(d["sherds"]) >= 1
-    assert d["summary"].startswith("%d sherds" % len(d["sherds"]))
+    sherds = json.loads(r.stdout)  # nothing but the JSON, even with stderr merged in
+    assert r.stderr == "" and r.stdout.count("\n") == 1  # one line: line readers take it too
+    assert isinstance(sherds, list) and len(sherds) == photo_result(photo)["sherd_count"] >= 1
+    for s in sherds:
+        assert s["px_per_cm"] == photo_result(photo)["px_per_cm"]
+        assert s["length_mm"] >= s["width_mm"] > 0 and isinstance(s["flags"], list)
     assert not list(tmp_path.iterdir())  # the photo's name was not taken for a JSON file
+
+
+def test_report_on_stdout_is_one_object_with_the_photo_wide_findings(tmp_path):
+    photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
+    for args in (["--report", photo], ["--format", "report", photo], [photo, "--report", "-"]):
+        r = segment(*args, "--no-overlay", cwd=tmp_path)
+        d = json.loads(r.stdout)
+        assert r.stderr == "" and d["sherd_count"] == len(d["sherds"]) >= 1
+        assert d["summary"].startswith("%d sherds" % len(d["sherds"]))
+    assert not list(tmp_path.iterdir())
 
 
 def test_a_read_only_folder_only_warns_about_the_default_overlay(tmp_path):
@@ -112,14 +132,16 @@ def test_a_read_only_folder_only_warns_about_the_default_overlay(tmp_path):
     ro.mkdir()
     ro.chmod(0o555)
     try:
-        r = segment(photo, "--json", cwd=ro)
+        r = segment(photo, "--format", "table", cwd=ro)
+        quiet = segment(photo, "--json", cwd=ro)  # JSON for a program: stderr stays empty
     finally:
         ro.chmod(0o755)
     if os.geteuid() == 0:  # root writes anyway: the overlay is simply there
         assert (ro / "img040DSC02176_segmented.jpg").exists()
     else:
         assert "warning: cannot write the overlay" in r.stderr
-    assert r.returncode in (0, 1) and json.loads(r.stdout)["sherds"]
+    assert r.returncode in (0, 1) and "length mm" in r.stdout
+    assert quiet.returncode in (0, 1) and quiet.stderr == "" and json.loads(quiet.stdout)
 
 
 def test_overlay_is_written_where_asked_and_by_default_beside(tmp_path):
@@ -137,6 +159,8 @@ def test_help_names_every_option_and_the_exit_codes():
     assert r.returncode == 0
     for option in (
         "--json",
+        "--report",
+        "--format",
         "--overlay",
         "--no-overlay",
         "--mask",
@@ -153,6 +177,8 @@ def test_help_names_every_option_and_the_exit_codes():
     [
         (["--bogus", "x.jpg"], "unknown option --bogus"),
         (["--bar-length", "abc", "x.jpg"], "--bar-length"),
+        (["--format", "xml", "x.jpg"], "--format"),
+        (["--json", "-", "--report", "-", "x.jpg"], "cannot both go to stdout"),
         ([], "no photo given"),
         (["/nonexistent/photo.jpg"], "does not exist"),
     ],
@@ -178,11 +204,11 @@ def test_a_photo_without_a_scale_bar_is_doubtful_and_says_so(tmp_path):
 
 def test_json_round_trip_matches_the_table(tmp_path):
     photo = os.path.join(PHOTOS, "img005DSC02101.jpg")
-    r = segment(photo, "--json", str(tmp_path / "r.json"), "--no-overlay")
-    d = json.loads((tmp_path / "r.json").read_text())
+    r = segment(photo, "--json", str(tmp_path / "r.json"), "--format", "table", "--no-overlay")
+    sherds = json.loads((tmp_path / "r.json").read_text())
     rows = r.stdout.strip().splitlines()[1:]
-    assert len(rows) == len(d["sherds"])
-    for row, s in zip(rows, d["sherds"], strict=True):
+    assert len(rows) == len(sherds)
+    for row, s in zip(rows, sherds, strict=True):
         cols = row.split()
         assert int(cols[0]) == s["id"]
         assert abs(float(cols[1]) - s["length_mm"]) < 0.051

@@ -1,5 +1,6 @@
 // segment_image: sherds and the scale bar in a photo (no ROS). `segment_image --help` says it all.
 #include <getopt.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -13,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rascal_perception/PhotoSegmenter.hpp"
@@ -29,11 +31,16 @@ const char* kHelp =
     "photo of sherds on a cloth, and measures each sherd in mm once the bar is found.\n"
     "\n"
     "options:\n"
-    "  --json [FILE]        the result as JSON instead of the table: on stdout (no FILE, or '-'), else\n"
-    "                       written to FILE as well as the table; a FILE not ending in .json needs\n"
-    "                       --json=FILE. On stdout the JSON is all that is printed (its \"summary\"\n"
-    "                       and \"doubts\" say what the summary line on stderr says otherwise)\n"
-    "  --format table|json  the same as no --json / --json with no FILE\n"
+    "  --json [FILE], -j    the sherds as one JSON list, one object per sherd (id, length_mm,\n"
+    "                       width_mm, area_mm2, px_per_cm, flags, centre_px, box_px, angle_deg,\n"
+    "                       area_px, colour): on stdout (no FILE, or '-'), else written to FILE as\n"
+    "                       well as the table; a FILE not ending in .json needs --json=FILE\n"
+    "  --report [FILE]      the whole result as one JSON object (summary, px/cm, the scale bar's\n"
+    "                       box and doubt, the photo-wide doubts and the sherds): on stdout or FILE\n"
+    "  --format table|json|report\n"
+    "                       what stdout holds; without it, the table on a terminal and the JSON\n"
+    "                       list when stdout is a pipe or a file. With JSON on stdout nothing else\n"
+    "                       is printed (no summary line on stderr: the exit code and the flags say it)\n"
     "  --overlay FILE       write the overlay image there (default: PHOTO-STEM_segmented.jpg in the\n"
     "                       current folder): outlines and ids, flagged sherds in orange, the bar\n"
     "  --no-overlay         write no overlay image\n"
@@ -59,17 +66,19 @@ bool endsWith(std::string s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-// `--json` takes the next word as its FILE only when it is '-' or a .json name: `--json` last,
-// before another option or before the photo means stdout (the common calls
-// `segment_image PHOTO --json` and `segment_image --json PHOTO`).
+// `--json` / `--report` take the next word as their FILE only when it is '-' or a .json name:
+// last, before another option or before the photo they mean stdout (the common calls
+// `segment_image PHOTO --json` and `segment_image --json PHOTO`). `-j` is `--json`.
 std::vector<char*> withJsonFileResolved(int argc, char** argv) {
-  static char kStdout[] = "--json=-";
+  static char kJson[] = "--json", kJsonStdout[] = "--json=-", kReportStdout[] = "--report=-";
   std::vector<char*> out(argv, argv + argc);
   for (size_t i = 1; i < out.size(); ++i) {
     if (std::string(out[i]) == "--") break;
-    if (std::string(out[i]) != "--json") continue;
+    if (std::string(out[i]) == "-j") out[i] = kJson;
+    const std::string word = out[i];
+    if (word != "--json" && word != "--report") continue;
     const bool has_file = i + 1 < out.size() && (std::string(out[i + 1]) == "-" || endsWith(out[i + 1], ".json"));
-    if (!has_file) out[i] = kStdout;
+    if (!has_file) out[i] = word == "--json" ? kJsonStdout : kReportStdout;
   }
   return out;
 }
@@ -123,7 +132,42 @@ std::string summaryOf(const PhotoResult& r) {
   return summary + (d.empty() ? "" : " (doubtful: exit 1)");
 }
 
-std::string json(const std::string& image, const cv::Mat& rgb, const PhotoResult& r) {
+/// One sherd as a JSON object: what a catalogue wants first (sizes, scale, flags), then pixels.
+void sherdJson(const PhotoResult& r, size_t i, std::ostream& o) {
+  const PhotoSherd& s = r.sherds[i];
+  const cv::RotatedRect& b = s.blob.box;
+  o << "{\"id\": " << i + 1;
+  if (r.bar.found) {
+    o << ", \"length_mm\": " << s.length_mm << ", \"width_mm\": " << s.width_mm << ", \"area_mm2\": " << s.area_mm2
+      << ", \"px_per_cm\": " << r.bar.px_per_cm;
+  } else {
+    o << ", \"length_mm\": null, \"width_mm\": null, \"area_mm2\": null, \"px_per_cm\": null";
+  }
+  o << ", \"flags\": [";
+  const std::vector<std::string> f = flagNames(s.flags);
+  for (size_t k = 0; k < f.size(); ++k) o << (k ? ", " : "") << "\"" << f[k] << "\"";
+  o << "], \"centre_px\": [" << b.center.x << ", " << b.center.y << "], \"box_px\": ["
+    << std::max(b.size.width, b.size.height) << ", " << std::min(b.size.width, b.size.height)
+    << "], \"angle_deg\": " << b.angle << ", \"area_px\": " << s.blob.pixels << ", \"colour\": [" << s.colour[0]
+    << ", " << s.colour[1] << ", " << s.colour[2] << "]}";
+}
+
+/// `--json`: the sherds as one JSON list on one line, the shape tools that read lists expect.
+std::string sherdList(const PhotoResult& r) {
+  std::ostringstream o;
+  o.setf(std::ios::fixed);
+  o.precision(2);
+  o << "[";
+  for (size_t i = 0; i < r.sherds.size(); ++i) {
+    o << (i ? ", " : "");
+    sherdJson(r, i, o);
+  }
+  o << "]\n";
+  return o.str();
+}
+
+/// `--report`: the whole result, the photo-wide findings beside the sherds.
+std::string report(const std::string& image, const cv::Mat& rgb, const PhotoResult& r) {
   std::ostringstream o;
   o.setf(std::ios::fixed);
   o.precision(2);
@@ -145,18 +189,8 @@ std::string json(const std::string& image, const cv::Mat& rgb, const PhotoResult
   for (size_t i = 0; i < d.size(); ++i) o << (i ? ", " : "") << "\"" << escape(d[i]) << "\"";
   o << "],\n  \"sherds\": [";
   for (size_t i = 0; i < r.sherds.size(); ++i) {
-    const PhotoSherd& s = r.sherds[i];
-    const cv::RotatedRect& b = s.blob.box;
-    o << (i ? ",\n" : "\n") << "    {\"id\": " << i + 1 << ", \"centre_px\": [" << b.center.x << ", " << b.center.y
-      << "], \"box_px\": [" << std::max(b.size.width, b.size.height) << ", " << std::min(b.size.width, b.size.height)
-      << "], \"angle_deg\": " << b.angle << ", \"area_px\": " << s.blob.pixels;
-    if (r.bar.found) {
-      o << ", \"length_mm\": " << s.length_mm << ", \"width_mm\": " << s.width_mm << ", \"area_mm2\": " << s.area_mm2;
-    }
-    o << ", \"colour\": [" << s.colour[0] << ", " << s.colour[1] << ", " << s.colour[2] << "], \"flags\": [";
-    const std::vector<std::string> f = flagNames(s.flags);
-    for (size_t k = 0; k < f.size(); ++k) o << (k ? ", " : "") << "\"" << f[k] << "\"";
-    o << "]}";
+    o << (i ? ",\n    " : "\n    ");
+    sherdJson(r, i, o);
   }
   o << "\n  ]\n}\n";
   return o.str();
@@ -212,6 +246,7 @@ cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
 
 int main(int argc, char** argv) {
   static const option kLong[] = {{"json", required_argument, nullptr, 'j'},
+                                 {"report", required_argument, nullptr, 'r'},
                                  {"format", required_argument, nullptr, 'f'},
                                  {"overlay", required_argument, nullptr, 'o'},
                                  {"no-overlay", no_argument, nullptr, 'n'},
@@ -222,7 +257,8 @@ int main(int argc, char** argv) {
                                  {"clusters", required_argument, nullptr, 'k'},
                                  {"help", no_argument, nullptr, 'h'},
                                  {nullptr, 0, nullptr, 0}};
-  std::string json_path, overlay_path, mask_path, labels_path, background;
+  std::string json_path, report_path, overlay_path, mask_path, labels_path, background;
+  std::string format;  // what stdout holds: table, json or report
   bool overlay = true;
   PhotoSegmenter::Options options;
   opterr = 0;  // our own one-line messages
@@ -234,9 +270,12 @@ int main(int argc, char** argv) {
     try {
       switch (c) {
         case 'j': json_path = arg; break;
+        case 'r': report_path = arg; break;
         case 'f':
-          if (arg == "json") json_path = "-";
-          else if (arg != "table") return badUsage("bad value '" + arg + "' for --format (table or json)");
+          if (arg != "table" && arg != "json" && arg != "report") {
+            return badUsage("bad value '" + arg + "' for --format (table, json or report)");
+          }
+          format = arg;
           break;
         case 'o': overlay_path = arg; break;
         case 'n': overlay = false; break;
@@ -264,6 +303,15 @@ int main(int argc, char** argv) {
                       (c == 'l' ? std::string("bar-length (a length in cm, e.g. 10)") : std::string("clusters (2..12)")));
     }
   }
+  if (json_path == "-" && report_path == "-") return badUsage("--json and --report cannot both go to stdout");
+  const std::string asked = json_path == "-" ? "json" : report_path == "-" ? "report" : "";
+  if (!format.empty() && !asked.empty() && format != asked) {
+    return badUsage("--format " + format + " and --" + asked + " - ask for different things on stdout");
+  }
+  // A person at a terminal reads the table; a pipe or a file gets what a program reads.
+  if (format.empty()) format = !asked.empty() ? asked : isatty(STDOUT_FILENO) ? "table" : "json";
+  if (json_path == "-") json_path.clear();
+  if (report_path == "-") report_path.clear();
   if (optind >= argc) return badUsage("no photo given");
   if (argc - optind > 1) return badUsage("one photo at a time; got '" + std::string(argv[optind + 1]) + "' too");
   const std::string image = argv[optind];
@@ -280,15 +328,17 @@ int main(int argc, char** argv) {
     return badUsage(e.what());
   }
   try {
-    if (json_path == "-") {
-      std::cout << json(image, rgb, r);
-    } else {
-      if (!json_path.empty()) {
-        std::ofstream f(json_path);
-        if (!(f << json(image, rgb, r))) throw std::runtime_error("cannot write --json " + json_path);
+    const std::pair<const std::string*, std::string> files[] = {{&json_path, "--json"}, {&report_path, "--report"}};
+    for (const auto& [path, option] : files) {
+      if (path->empty()) continue;
+      std::ofstream f(*path);
+      if (!(f << (option == "--json" ? sherdList(r) : report(image, rgb, r)))) {
+        throw std::runtime_error("cannot write " + option + " " + *path);
       }
-      table(r, std::cout);
     }
+    if (format == "json") std::cout << sherdList(r);
+    if (format == "report") std::cout << report(image, rgb, r);
+    if (format == "table") table(r, std::cout);
     if (!mask_path.empty() && !cv::imwrite(mask_path, r.foreground)) throw std::runtime_error("cannot write --mask " + mask_path);
     if (!labels_path.empty()) {  // the ids of the table and the JSON, for tools that measure each sherd
       cv::Mat labels = cv::Mat::zeros(rgb.size(), CV_16U);
@@ -308,7 +358,9 @@ int main(int argc, char** argv) {
       }
       // The default overlay lands in the current folder, which may be read-only: the result is
       // still good, so that is a warning; an --overlay asked for is an error.
-      if (!written && default_overlay) {
+      if (!written && default_overlay && format != "table") {
+        // stdout is JSON for a program: stderr stays empty so merged output still parses
+      } else if (!written && default_overlay) {
         std::fprintf(stderr, "segment_image: warning: cannot write the overlay %s here; use --overlay FILE or --no-overlay\n",
                      overlay_path.c_str());
       } else if (!written) {
@@ -318,6 +370,6 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return badUsage(e.what());
   }
-  if (json_path != "-") std::fprintf(stderr, "segment_image: %s\n", summaryOf(r).c_str());
+  if (format == "table") std::fprintf(stderr, "segment_image: %s\n", summaryOf(r).c_str());
   return doubts(r).empty() ? kConfident : kDoubtful;
 }

@@ -53,7 +53,7 @@ def segment(photo: str):
     with tempfile.TemporaryDirectory(prefix="archival_photo_") as tmp:
         labels_path = os.path.join(tmp, "labels.png")
         r = subprocess.run(
-            [segment_image_tool(), photo, "--json", "-", "--no-overlay", "--labels", labels_path],
+            [segment_image_tool(), photo, "--report", "-", "--no-overlay", "--labels", labels_path],
             capture_output=True,
             text=True,
             timeout=120,
