@@ -34,7 +34,7 @@ const char* kHelp =
     "  --json [FILE], -j    the sherds as one JSON list, one object per sherd (id, length_mm,\n"
     "                       width_mm, area_mm2, px_per_cm, flags, centre_px, box_px, angle_deg,\n"
     "                       area_px, colour): on stdout (no FILE, or '-'), else written to FILE as\n"
-    "                       well as the table; a FILE not ending in .json needs --json=FILE\n"
+    "                       well as what stdout holds; a FILE not ending in .json needs --json=FILE\n"
     "  --report [FILE]      the whole result as one JSON object (summary, px/cm, the scale bar's\n"
     "                       box and doubt, the photo-wide doubts and the sherds): on stdout or FILE\n"
     "  --format table|json|report\n"
