@@ -26,6 +26,35 @@ TEST(DriverMonitor, ASmoothlyMovingArmIsNoRestart) {
   EXPECT_EQ(m.reason(), "");
 }
 
+TEST(DriverMonitor, PositionsAFewMillisecondsLateAreNoJump) {
+  // The emulated rig: the servos move on the emulator's own copy of /clock, which on a loaded
+  // machine stands still for a while and then catches up, while the driver stamps on its copy:
+  // a position is up to 30 ms older than its stamp, then none (between two messages 5 ms apart
+  // that read as 0.11 rad in 5 ms).
+  DriverMonitor m = monitor();
+  const double lag[] = {0.030, 0.0, 0.020, 0.0, 0.025};
+  for (int k = 0; k < 400; ++k) {  // 2 s at 200 Hz, the wrist at the speed limit
+    const double t = 100.0 + 0.005 * k;
+    JointVector q = kOverPickup;
+    q[5] += 3.14159 * (t - lag[k % 5] - 100.0);
+    m.addJointState(t, q);
+  }
+  EXPECT_FALSE(m.restarted()) << m.reason();
+}
+
+TEST(DriverMonitor, AStepInTheMiddleOfAMoveIsStillAJump) {
+  DriverMonitor m = monitor();
+  JointVector q = kOverPickup;
+  for (int k = 0; k < 100; ++k) {
+    q[0] += 1.0 * 0.005;  // 1 rad/s
+    m.addJointState(10.0 + 0.005 * k, q);
+  }
+  ASSERT_FALSE(m.restarted());
+  m.addJointState(10.5, kSleep);
+  ASSERT_TRUE(m.restarted());
+  EXPECT_EQ(m.reason().rfind("shoulder jumped", 0), 0u) << m.reason();
+}
+
 TEST(DriverMonitor, JointStateTimeGoingBackwardsIsARestart) {
   DriverMonitor m = monitor();
   m.addJointState(312.41, kOverPickup);

@@ -18,6 +18,11 @@ class DriverMonitor {
   // Speed headroom and slack [rad] before a change between two messages counts as a jump.
   static constexpr double kSpeedHeadroom = 1.5;
   static constexpr double kJumpSlack = 0.05;
+  // [s] the least time a change is judged over: a position can be this much older than its
+  // stamp (a driver on simulated time stamps what another process moved on its own copy of
+  // /clock, which on a loaded machine stands still and then catches up), so 5 ms between two
+  // messages is judged as 50 ms. A restart's step to the reset pose is still far beyond it.
+  static constexpr double kLeastInterval = 0.05;
 
   explicit DriverMonitor(const Settings& settings) : settings_(settings) {}
 

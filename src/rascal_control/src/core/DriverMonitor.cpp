@@ -1,5 +1,6 @@
 #include "rascal_control/DriverMonitor.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -19,7 +20,8 @@ void DriverMonitor::addJointState(double stamp, const JointVector& q) {
       std::snprintf(text, sizeof(text), "/joint_states time went backwards (%.3f s -> %.3f s)", last_stamp_, stamp);
       flag(text);
     } else {
-      const double allowed = settings_.max_speed * kSpeedHeadroom * (stamp - last_stamp_) + kJumpSlack;
+      const double allowed =
+          settings_.max_speed * kSpeedHeadroom * std::max(stamp - last_stamp_, kLeastInterval) + kJumpSlack;
       std::size_t joint = 0;
       double step = 0.0;
       for (std::size_t j = 0; j < kArmJoints; ++j) {
