@@ -8,7 +8,8 @@ import subprocess
 import time
 
 import pytest
-from rig_helpers import SCENARIOS, ground_truth, inject, joint_positions, rows, run_batch
+import yaml
+from rig_helpers import SCENARIOS, SMALL, ground_truth, inject, joint_positions, rows, run_batch
 
 from rascal_tasks import exit_codes
 
@@ -34,6 +35,13 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
         )
         assert abs(r["mass_g"] - truth[name][2] * 1000) < 0.2, (r["seq"], name, r["mass_g"])
         names.add(name)
+        # the wall, not the height as it lies (the curved shells stand 1-3 mm higher than their
+        # wall); the scanned fragment has no one wall thickness to compare with
+        with open(SMALL) as f:
+            spec = {s["name"]: s for s in yaml.safe_load(f)["sherds"]}[name]
+        if "mesh" not in spec:
+            assert r["thickness_mm"] is not None, (r["seq"], name)
+            assert abs(r["thickness_mm"] - spec["thickness"] * 1000) < 1.0, (r["seq"], name, r)
     assert len(names) == 3, recorded
     # The archival image exists, is the one recorded, and shows something on the mat.
     import cv2

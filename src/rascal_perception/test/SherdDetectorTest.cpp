@@ -56,6 +56,8 @@ struct Tally {
   // true outline's principal axis (aspect >= 1.3); *_generator: against the generator's own
   // bounding-box axes (SherdTruth length/width/yaw), which are ambiguous for rounded outlines
   std::vector<double> centre, size, yaw, height, centre_generator, size_generator, yaw_generator;
+  std::vector<double> thickness, height_as_thickness;  // |error| of the wall thickness; of the height instead
+  int no_thickness = 0;
 };
 
 void score(const Frame& f, const DetectionResult& r, Tally& t, const std::string& tag) {
@@ -93,6 +95,12 @@ void score(const Frame& f, const DetectionResult& r, Tally& t, const std::string
       t.yaw_generator.push_back(angleDiff(s.yaw, g.yaw));
     }
     t.height.push_back(std::fabs(s.centre.z() - g.top));
+    if (s.thickness > 0.0) {
+      t.thickness.push_back(std::fabs(s.thickness - g.thickness));
+      t.height_as_thickness.push_back(std::fabs(s.height - g.thickness));
+    } else {
+      ++t.no_thickness;
+    }
     if (std::getenv("RASCAL_PERCEPTION_VERBOSE")) {
       std::printf("%s %s: truth %.1f x %.1f yaw %.1f | got %.1f x %.1f yaw %.1f | centre err %.2f mm\n", tag.c_str(),
                   g.name.c_str(), g.length * 1e3, g.width * 1e3, g.yaw * 180 / M_PI, s.length * 1e3, s.width * 1e3,
@@ -207,6 +215,13 @@ TEST(SherdDetector, GeneratedScenesUnderFieldLighting) {
   EXPECT_LE(percentile(t.size, 0.95), 0.003);
   EXPECT_LE(percentile(t.yaw, 0.95), 5.0 * M_PI / 180);
   EXPECT_LE(percentile(t.height, 0.95), 0.002);
+  std::printf("wall thickness: %zu measured, %d not; |error| median %.2f mm, p95 %.2f mm, max %.2f mm "
+              "(the height as it lies instead: median %.2f mm, p95 %.2f mm)\n",
+              t.thickness.size(), t.no_thickness, 1e3 * percentile(t.thickness, 0.5),
+              1e3 * percentile(t.thickness, 0.95), 1e3 * percentile(t.thickness, 1.0),
+              1e3 * percentile(t.height_as_thickness, 0.5), 1e3 * percentile(t.height_as_thickness, 0.95));
+  EXPECT_GE(t.thickness.size(), 0.95 * t.found);
+  EXPECT_LE(percentile(t.thickness, 0.95), 0.001);
 }
 
 TEST(SherdDetector, SplitsTouchingPairs) {

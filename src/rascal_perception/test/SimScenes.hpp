@@ -17,6 +17,7 @@ struct Truth {
   std::string name;
   Eigen::Vector2d centre;
   double yaw = 0.0, length = 0.0, width = 0.0, top = 0.0;  ///< top: z of the box top
+  double thickness = 0.0;  ///< [m] wall thickness (vertical, as the simulator builds the shell)
   std::vector<Eigen::Vector2d> outline;  ///< true outline in base_link (x, y)
   double principal_yaw = 0.0;            ///< major axis of the outline's area moments
   /// Extents of the true outline along `yaw` and across it, and the centre of that box.

@@ -28,6 +28,7 @@ class Sherd:
     length: float = 0.05
     width: float = 0.04
     height: float = 0.01
+    thickness: float = 0.007  # wall (the height as it lies adds its curvature)
     mass: float = 0.020  # kg
     station: Optional[str] = "pickup"  # None: on the table, off every station
 
@@ -148,6 +149,7 @@ class _Perception(rig.Perception):
                 surface + GRASP_ABOVE,
                 0.0,
                 s.width + 0.012,
+                thickness=s.thickness,
             )
             for s in self.w.lying(station)
             if math.hypot(s.x - cx, s.y - cy) < VIEW_RADIUS
@@ -242,7 +244,7 @@ class Recorder:
         self.writes.append(("picked", seq))
         return seq
 
-    def dimensions(self, seq, length, width, thickness):
+    def dimensions(self, seq, length, width, thickness, height=None):
         self.writes.append(("dimensions", seq))
 
     def mass(self, seq, kg, stable=True, seconds=None):

@@ -188,7 +188,7 @@ def test_a_sherd_lost_on_the_way_is_found_in_the_pickup_area_by_its_likeness(dat
     assert Recover(batch).run() == "held"
     assert batch.rig.arm.at == (lookalike.grasp_x, lookalike.grasp_y)
     assert batch.sherd.where == "pickup" and batch.sherd.observation is lookalike
-    assert ("dimensions", 4, 0.054, 0.041, 0.01) in batch.recorder.calls
+    assert ("dimensions", 4, 0.054, 0.041, 0.0, 0.01) in batch.recorder.calls  # no wall seen
     # looked at the scale first, then where it was picked, then over the pickup area
     assert batch.rig.perception.views[:2] == ["scale", "pickup"]
 

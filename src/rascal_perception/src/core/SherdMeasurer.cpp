@@ -1,5 +1,7 @@
 #include "rascal_perception/SherdMeasurer.hpp"
 
+#include "rascal_perception/WallThickness.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -8,6 +10,9 @@ namespace rascal_perception {
 
 namespace {
 constexpr double kMinPointHeight = 0.0015;  ///< [m] lower points belong to the table (noise, edges)
+/// [px] depth pixels nearer the outline than this mix the sherd's depth with the table's (the
+/// D435's flying pixels at edges): they are left out of the wall-thickness fit.
+constexpr float kInteriorMargin = 3.0f;
 
 double wrapHalfPi(double a) {
   while (a > M_PI / 2) a -= M_PI;
@@ -76,8 +81,16 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
   const uint16_t dmax = static_cast<uint16_t>(std::min(65535.0, config_.depth_max * 1000.0));
   std::vector<cv::Point2f> footprint;  // [mm] in the plane, base_link x, y
   std::vector<float> heights;
+  std::vector<TopSample> top_surface;
   footprint.reserve(blob.pixels);
   heights.reserve(blob.pixels);
+  top_surface.reserve(blob.pixels);
+  cv::Mat inside;  // [px] to the outline (the mask padded: its box's edge is outside too)
+  {
+    cv::Mat padded;
+    cv::copyMakeBorder(blob.mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::distanceTransform(padded, inside, cv::DIST_L2, 3);
+  }
   cv::Vec3d colour(0, 0, 0);
   int coloured = 0;
   for (int y = 0; y < blob.mask.rows; ++y) {
@@ -98,6 +111,7 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
       const Eigen::Vector3d q = p - h * n;
       footprint.emplace_back(static_cast<float>(q.x() * 1000.0), static_cast<float>(q.y() * 1000.0));
       heights.push_back(static_cast<float>(h));
+      top_surface.push_back({q.x(), q.y(), h, inside.at<float>(y + 1, x + 1) > kInteriorMargin});
     }
   }
   out = SherdDetection();
@@ -107,6 +121,9 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
     const size_t i95 = heights.size() * 95 / 100;
     std::nth_element(heights.begin(), heights.begin() + i95, heights.end());
     out.height = heights[i95];
+    const WallThickness wall = WallThickness::estimate(top_surface);
+    out.thickness = wall.valid ? wall.thickness : 0.0;
+    out.thickness_why = wall.why;
   } else {
     footprint.clear();
   }

@@ -72,6 +72,7 @@ rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& head
   s.length = d.length;
   s.width = d.width;
   s.height = d.height;
+  s.thickness = d.thickness;
   s.area = d.area;
   s.color.r = static_cast<float>(d.colour.x());
   s.color.g = static_cast<float>(d.colour.y());
@@ -151,7 +152,8 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
     text.scale.z = 0.012;
     text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
     char buf[96];
-    std::snprintf(buf, sizeof(buf), "#%zu %.0fx%.0fx%.0f mm", i, d.length * 1e3, d.width * 1e3, d.height * 1e3);
+    std::snprintf(buf, sizeof(buf), "#%zu %.0fx%.0f mm, wall %.1f mm", i, d.length * 1e3, d.width * 1e3,
+                  d.thickness * 1e3);
     text.text = buf;
     a.markers.push_back(text);
   }

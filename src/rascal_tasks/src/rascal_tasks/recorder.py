@@ -71,8 +71,10 @@ class Recorder:
         self._ids[rec["seq"]] = rec["sherd_id"]
         return rec["seq"]
 
-    def dimensions(self, seq, length, width, thickness):
-        self._wrist[seq] = (length * 1000.0, width * 1000.0, thickness)
+    def dimensions(self, seq, length, width, thickness, height=None):
+        """The wrist camera's length, width, wall thickness (0: not measured, recorded empty)
+        and height as the sherd lies [m] (the archival analysis's parallax; default thickness)."""
+        self._wrist[seq] = (length * 1000.0, width * 1000.0, height or thickness)
         self.catalogue.record_dimensions(
             self._id(seq),
             length * 1000.0,
@@ -137,7 +139,7 @@ class Recorder:
         wrist = self._wrist.get(seq)
         if wrist is None:  # a resumed sherd: what the catalogue holds
             row = self.catalogue.get(self._id(seq))
-            if row.get("length_mm") and row.get("width_mm"):
+            if row.get("length_mm") and row.get("width_mm"):  # its height was not kept: the wall
                 wrist = (row["length_mm"], row["width_mm"], (row.get("thickness_mm") or 0) / 1e3)
         return wrist
 

@@ -37,6 +37,7 @@ class Observation:
     grasp_width: float  # opening before closing
     colour: Tuple[float, float, float] = (0.0, 0.0, 0.0)
     score: float = 1.0
+    thickness: float = 0.0  # wall thickness from depth (0 = not measured)
 
     def distance_to(self, x: float, y: float) -> float:
         return math.hypot(self.x - x, self.y - y)

@@ -62,6 +62,7 @@ def observation_from_msg(s) -> rig.Observation:
         length=s.length,
         width=s.width,
         height=s.height,
+        thickness=s.thickness,
         grasp_x=s.grasp_pose.position.x,
         grasp_y=s.grasp_pose.position.y,
         grasp_z=s.grasp_pose.position.z,

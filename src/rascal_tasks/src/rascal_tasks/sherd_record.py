@@ -70,7 +70,7 @@ class SherdRecord:
 
     # -- catalogue writes (each commits) ---------------------------------------------------------
     def record_dimensions(self, o: Observation):
-        self.batch.recorder.dimensions(self.seq, o.length, o.width, o.height)
+        self.batch.recorder.dimensions(self.seq, o.length, o.width, o.thickness, o.height)
 
     def record_mass(self, kg: float, stable: bool = True):
         """A settled mass (stations.ScaleStation's rule); an unstable one is never recorded."""
