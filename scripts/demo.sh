@@ -29,7 +29,6 @@ if [ "${RIG:-sim}" = emulated ]; then
   # the configuration, sim, emulated_devices, arm_driver, scale_driver, arm_controller and
   # sherd_detector in order, each healthy before the next (src/rascal_drivers/README.md).
   echo "demo: context $context; emulated rig: arm_driver and scale_driver on the servo-bus and scale emulators"
-  echo "demo: work in progress: on a loaded machine the batch may stop after 1-3 sherds (src/rascal_drivers/README.md, Not done)"
   exec rosrun rascal_drivers rig --emulated --port 0 -- bash -c "
     rosrun rascal_tasks rascal run --context '$context' &&
     rosrun rascal_tasks rascal report --context '$context'"
