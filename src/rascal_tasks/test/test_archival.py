@@ -418,12 +418,7 @@ def _chart_of(rgb):
 
 
 def _matrix_only(patches, clipped):
-    saved = col.LINEARISE
-    col.LINEARISE = False
-    try:
-        return col.fit(patches, clipped).mean_delta_e00
-    finally:
-        col.LINEARISE = saved
+    return col.fit(patches, clipped, tone_curve="none").mean_delta_e00
 
 
 def test_the_end_of_a_batch_catches_up_only_its_own_photos_and_only_till_its_deadline(

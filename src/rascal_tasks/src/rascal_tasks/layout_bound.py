@@ -96,10 +96,9 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float]) -> List[Step]:
             # today the tare waits a stable window before the sherd is placed
             steps.append(Step("over scale", (x, y, travel), serial_wait=scale["stable_window"]))
             steps.append(Step("place on scale", (x, y, z), wait=margin_stroke))
-            steps.append(Step("hover", (x, y, z + approach)))
             settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
+            steps.append(Step("hover", (x, y, z + approach), wait=settle))  # while it settles
             steps.append(Step("settled; descend", (x, y, z), wait=margin_stroke))
-            steps[-2].wait = settle  # the arm hovers while the load settles
         else:
             steps.append(Step("over " + name, (x, y, travel)))
             steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke))

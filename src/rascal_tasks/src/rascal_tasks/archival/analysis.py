@@ -77,14 +77,16 @@ def analyse_rgb(
     wrist_size_mm: Optional[Tuple[float, float]] = None,
     object_height_m: float = 0.0,
     hint_px: Optional[Tuple[float, float]] = None,
+    tone_curve: str = "full",
 ) -> ArchivalResult:
+    """`tone_curve`: colour.fit's (a comparison's choice; the rig's is "full")."""
     geometry = geometry if geometry is not None else Geometry()
     r = ArchivalResult()
     feats = ch.photo_features(rgb)
-    chart, corr = chart_correction(rgb, feats, geometry.chart, r)
+    chart, corr = chart_correction(rgb, feats, geometry.chart, r, tone_curve)
     if corr is not None:
         r.corrected = col.correct_image(rgb, corr)
-    bar = _find_bar(rgb, feats, geometry, chart, r)
+    bar = locate_bar(rgb, feats, geometry, chart, r)
     if bar is not None:
         r.bar_reprojection_px = bar.reprojection_px
         r.px_per_cm = ch.bar_px_per_cm(bar, geometry.bar)
@@ -134,7 +136,9 @@ def analyse_rgb(
     return r
 
 
-def chart_correction(rgb: np.ndarray, feats, spec: ch.ChartSpec, r: ArchivalResult):
+def chart_correction(
+    rgb: np.ndarray, feats, spec: ch.ChartSpec, r: ArchivalResult, tone_curve: str = "full"
+):
     """(the chart located, the colour correction fitted from it), either None where it failed;
     what went wrong or is doubtful is flagged in `r`, with the chart's reprojection error and
     CIEDE2000 after correction."""
@@ -148,7 +152,7 @@ def chart_correction(rgb: np.ndarray, feats, spec: ch.ChartSpec, r: ArchivalResu
         r.flags.append("colour chart fit %.1f px RMS" % chart.reprojection_px)
     try:
         patches, clipped = ch.sample_patches(rgb, chart, spec)
-        corr = col.fit(patches, clipped)
+        corr = col.fit(patches, clipped, tone_curve)
     except (ValueError, np.linalg.LinAlgError) as e:
         r.flags.append("no colour: %s" % e)
         return chart, None
@@ -187,7 +191,7 @@ def chart_px_per_cm(chart: ch.Located, spec: ch.ChartSpec) -> float:
     return float((w + h) / 2)
 
 
-def _find_bar(rgb, feats, geometry: Geometry, chart, r: ArchivalResult):
+def locate_bar(rgb, feats, geometry: Geometry, chart, r: ArchivalResult):
     """The bar by features (the seed's method), then refined by its outline: the one
     black-and-white rectangle of its proportions near where the features put it (sub-pixel
     edges over its whole length, where a few feature points leave ~0.5 % of scale error). With

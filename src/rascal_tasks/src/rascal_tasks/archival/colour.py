@@ -48,8 +48,7 @@ C = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["C"]
 METHOD = "Cheung 2004"  # 3 x 3 matrix (terms=3): exact for a diagonal light and a linear camera
 TERMS = 3
 CLIP_SHARE = 0.02  # a patch with more than this share of clipped pixels is left out of the fit
-LINEARISE = os.environ.get("RASCAL_NO_TONE_CURVE") is None  # comparison runs only
-RESIDUAL = os.environ.get("RASCAL_NO_TONE_RESIDUAL") is None  # comparison runs only
+TONE_CURVES = ("full", "power", "none")  # fit()'s choices; the others are for comparisons
 
 
 def decode(srgb8: np.ndarray) -> np.ndarray:
@@ -125,7 +124,7 @@ class Correction:
             return linear
         x = np.log(np.clip(linear, 1e-6, None))
         out = self.gain * np.exp(self.gamma * x)
-        if self.knots is not None and RESIDUAL:
+        if self.knots is not None:
             for c, (kx, ky) in enumerate(self.knots):
                 out[..., c] *= np.exp(np.interp(x[..., c], kx, ky))
         return out
@@ -136,7 +135,7 @@ class Correction:
         )
 
 
-def tone_curve(measured: np.ndarray, used: np.ndarray, ref: np.ndarray):
+def fit_tone_curve(measured: np.ndarray, used: np.ndarray, ref: np.ndarray):
     """(gain, gamma, knots) per channel mapping the grey patches' decoded values onto their
     published linear values: a straight line in log-log (least squares; white balance and
     gamma) and the greys' residuals from it, interpolated (a picture style's S-curve).
@@ -159,14 +158,25 @@ def tone_curve(measured: np.ndarray, used: np.ndarray, ref: np.ndarray):
     return gain, gamma, knots
 
 
-def fit(patches_srgb8: np.ndarray, clipped_share: np.ndarray) -> Correction:
-    """Fit the correction from the patches' measured 8-bit sRGB (24 x 3, chart order)."""
+def fit(
+    patches_srgb8: np.ndarray, clipped_share: np.ndarray, tone_curve: str = "full"
+) -> Correction:
+    """Fit the correction from the patches' measured 8-bit sRGB (24 x 3, chart order).
+    `tone_curve`: "full" (the greys' power law and its interpolated residuals, then the
+    matrix), "power" (the power law only) or "none" (the matrix alone): the last two are
+    there to measure what the curve brings (bench/archival_colour --tone-curve)."""
+    if tone_curve not in TONE_CURVES:
+        raise ValueError("tone_curve %r: expected one of %s" % (tone_curve, ", ".join(TONE_CURVES)))
     measured = decode(patches_srgb8)
     used = np.asarray(clipped_share) <= CLIP_SHARE
     if used.sum() < 8:
         raise ValueError("colour chart: only %d of 24 patches unclipped, need 8" % used.sum())
     ref = reference_linear()
-    gain, gamma, knots = tone_curve(measured, used, ref) if LINEARISE else (None,) * 3
+    gain, gamma, knots = (
+        fit_tone_curve(measured, used, ref) if tone_curve != "none" else (None,) * 3
+    )
+    if tone_curve == "power":
+        knots = None
     corr = Correction(np.eye(3), used, np.zeros(24), gain, gamma, knots)
     corr.matrix = colour.characterisation.matrix_colour_correction(
         corr.linearise(measured[used]), ref[used], method=METHOD, terms=TERMS

@@ -26,7 +26,7 @@ from rascal_tasks.archival import size as sz
 from rascal_tasks.archival.analysis import (
     ArchivalResult,
     Geometry,
-    _find_bar,
+    locate_bar,
     chart_correction,
     colour_of,
     read_rgb,
@@ -99,7 +99,7 @@ def analyse_photo(photo: str) -> dict:
     chart, corr = chart_correction(rgb, feats, geometry.chart, photo_r)
     bar = None
     if seg.get("px_per_cm") is None:  # the archival station's bar, when segment_image saw none
-        bar = _find_bar(rgb, feats, geometry, chart, photo_r)
+        bar = locate_bar(rgb, feats, geometry, chart, photo_r)
         if bar is not None:
             photo_r.px_per_cm = ch.bar_px_per_cm(bar, geometry.bar)
     targets = np.zeros(rgb.shape[:2], np.uint8)
