@@ -42,6 +42,12 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
         if "mesh" not in spec:
             assert r["thickness_mm"] is not None, (r["seq"], name)
             assert abs(r["thickness_mm"] - spec["thickness"] * 1000) < 1.0, (r["seq"], name, r)
+            # the vessel's outer diameter: the top face's when it is the outside, a wall more
+            # when it is the inside (the simulator's faces curve alike)
+            outer = 2000.0 / spec["curvature"]
+            outer += 0.0 if spec.get("convex_up", True) else 2000.0 * spec["thickness"]
+            assert r["vessel_diameter_mm"] is not None, (r["seq"], name, r)
+            assert abs(r["vessel_diameter_mm"] / outer - 1) < 0.15, (r["seq"], name, outer, r)
     assert len(names) == 3, recorded
     # The archival image exists, is the one recorded, and shows something on the mat.
     import cv2

@@ -121,6 +121,9 @@ Frame render(const Scenario& scenario, const JointVector& q) {
     t.width = s.width;
     t.top = s.pose.translation().z() + 0.5 * s.box_size.z();
     t.thickness = s.thickness;
+    t.curvature = s.curvature;
+    t.curvature_long = s.curvature_long;
+    t.convex_up = s.convex_up;
     std::vector<cv::Point2f> poly;
     for (const Eigen::Vector2d& p : s.outline) {
       const Eigen::Vector3d w = s.pose * Eigen::Vector3d(p.x(), p.y(), 0.0);

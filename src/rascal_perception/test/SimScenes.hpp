@@ -18,6 +18,9 @@ struct Truth {
   Eigen::Vector2d centre;
   double yaw = 0.0, length = 0.0, width = 0.0, top = 0.0;  ///< top: z of the box top
   double thickness = 0.0;  ///< [m] wall thickness (vertical, as the simulator builds the shell)
+  double curvature = 0.0;  ///< [1/m] across; both faces curve by it (vertical offsets)
+  double curvature_long = 0.0;  ///< [1/m] along (the vessel's profile)
+  bool convex_up = true;
   std::vector<Eigen::Vector2d> outline;  ///< true outline in base_link (x, y)
   double principal_yaw = 0.0;            ///< major axis of the outline's area moments
   /// Extents of the true outline along `yaw` and across it, and the centre of that box.

@@ -244,7 +244,7 @@ class Recorder:
         self.writes.append(("picked", seq))
         return seq
 
-    def dimensions(self, seq, length, width, thickness, height=None):
+    def dimensions(self, seq, length, width, thickness, height=None, diameter=(0.0, 0.0)):
         self.writes.append(("dimensions", seq))
 
     def mass(self, seq, kg, stable=True, seconds=None):

@@ -59,8 +59,11 @@ struct SherdDetection {
   double yaw = 0.0;            ///< [rad] major axis about +z, in (-pi/2, pi/2]
   double length = 0.0, width = 0.0, height = 0.0, area = 0.0;  ///< [m], [m^2]
   double surface = 0.0;        ///< [m] z of the station surface (fitted plane) under the centre
-  double thickness = 0.0;      ///< [m] wall thickness (WallThickness); 0 = not measured, see thickness_why
+  double thickness = 0.0;      ///< [m] wall thickness (ShellFit); 0 = not measured, see thickness_why
   std::string thickness_why;   ///< why there is no thickness
+  double diameter = 0.0;       ///< [m] vessel's outer diameter (ShellFit); 0 = not told, see diameter_why
+  double diameter_sigma = 0.0; ///< [m] its 1-sigma uncertainty
+  std::string diameter_why;
   Eigen::Vector3d colour = Eigen::Vector3d::Zero();  ///< mean sRGB [0, 1]
   Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();  ///< ee_gripper_link target
   double grasp_width = 0.0;    ///< [m] opening before closing, within the gripper's (30 .. 74 mm)

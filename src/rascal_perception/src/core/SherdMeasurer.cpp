@@ -1,6 +1,6 @@
 #include "rascal_perception/SherdMeasurer.hpp"
 
-#include "rascal_perception/WallThickness.hpp"
+#include "rascal_perception/ShellFit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +11,11 @@ namespace rascal_perception {
 namespace {
 constexpr double kMinPointHeight = 0.0015;  ///< [m] lower points belong to the table (noise, edges)
 /// [px] depth pixels nearer the outline than this mix the sherd's depth with the table's (the
-/// D435's flying pixels at edges): they are left out of the wall-thickness fit.
+/// D435's flying pixels at edges): they are left out of the shell fit (ShellFit).
 constexpr float kInteriorMargin = 3.0f;
+/// [mm] in the table plane, samples nearer the footprint's edge than this are left out of the
+/// shell fit too (side walls, below).
+constexpr float kWallMarginMm = 1.5f;
 
 double wrapHalfPi(double a) {
   while (a > M_PI / 2) a -= M_PI;
@@ -121,9 +124,6 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
     const size_t i95 = heights.size() * 95 / 100;
     std::nth_element(heights.begin(), heights.begin() + i95, heights.end());
     out.height = heights[i95];
-    const WallThickness wall = WallThickness::estimate(top_surface);
-    out.thickness = wall.valid ? wall.thickness : 0.0;
-    out.thickness_why = wall.why;
   } else {
     footprint.clear();
   }
@@ -171,6 +171,24 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
   const double range0 = n.dot(view.base_T_camera.translation()) + plane.w() - out.height;
   const int gap = std::max(3, static_cast<int>(std::ceil(2.0 * range0 / k.fx * 1000.0 / kCell)) | 1);
   cv::morphologyEx(top, top, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(gap, gap)));
+  if (out.depth_valid) {
+    // The shell fit takes only the top face: a sherd's side wall, seen obliquely away from the
+    // image centre (up to ~15 px for a 15 mm sherd 0.15 m off the axis at 0.3 m), stands on
+    // its outline in the table plane, so samples near the footprint's edge there are left out.
+    cv::Mat edge;
+    cv::distanceTransform(top, edge, cv::DIST_L2, 3);
+    for (TopSample& t : top_surface) {
+      const int r = static_cast<int>((t.y * 1000.0 - lo.y) / kCell) + pad;
+      const int c = static_cast<int>((t.x * 1000.0 - lo.x) / kCell) + pad;
+      t.interior = t.interior && edge.at<float>(r, c) * kCell >= kWallMarginMm;
+    }
+    const ShellFit shell = ShellFit::estimate(top_surface);
+    out.thickness = shell.valid ? shell.thickness : 0.0;
+    out.thickness_why = shell.why;
+    out.diameter = shell.diameter;
+    out.diameter_sigma = shell.diameter_sigma;
+    out.diameter_why = shell.diameter_why;
+  }
   const cv::Moments mo = cv::moments(top, true);
   if (mo.m00 <= 0) {
     why = "empty footprint";

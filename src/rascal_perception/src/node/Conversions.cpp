@@ -73,6 +73,8 @@ rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& head
   s.width = d.width;
   s.height = d.height;
   s.thickness = d.thickness;
+  s.vessel_diameter = d.diameter;
+  s.vessel_diameter_sigma = d.diameter_sigma;
   s.area = d.area;
   s.color.r = static_cast<float>(d.colour.x());
   s.color.g = static_cast<float>(d.colour.y());

@@ -20,6 +20,11 @@ struct SherdState {
   Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   double mass = 0.0, thickness = 0.0, length = 0.0, width = 0.0;
+  /// [1/m] the shell's curvature across (the vessel's: diameter 2 / curvature), 0 for a mesh;
+  /// the shell's faces are vertical offsets of one surface, so both faces curve by it
+  double curvature = 0.0;
+  double curvature_long = 0.0;  ///< [1/m] along (the vessel's profile)
+  bool convex_up = true;
   Eigen::Vector3d box_size = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector2d> outline;  ///< in the body frame
   Eigen::Vector3d colour = Eigen::Vector3d::Zero();

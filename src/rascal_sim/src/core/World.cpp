@@ -491,6 +491,9 @@ SherdState World::sherd(size_t i) const {
   st.angular_velocity = Eigen::Vector3d(a[0], a[1], a[2]);
   st.mass = s.geo.mass;
   st.thickness = s.spec.mesh_file.empty() ? s.spec.thickness : s.geo.box_size.z();
+  st.curvature = s.spec.mesh_file.empty() ? s.spec.curvature : 0.0;
+  st.curvature_long = s.spec.mesh_file.empty() ? s.spec.curvature_long : 0.0;
+  st.convex_up = s.spec.convex_up;
   st.length = s.geo.length;
   st.width = s.geo.width;
   st.box_size = s.geo.box_size;

@@ -71,15 +71,18 @@ class Recorder:
         self._ids[rec["seq"]] = rec["sherd_id"]
         return rec["seq"]
 
-    def dimensions(self, seq, length, width, thickness, height=None):
-        """The wrist camera's length, width, wall thickness (0: not measured, recorded empty)
-        and height as the sherd lies [m] (the archival analysis's parallax; default thickness)."""
+    def dimensions(self, seq, length, width, thickness, height=None, diameter=(0.0, 0.0)):
+        """The wrist camera's length, width, wall thickness (0: not measured, recorded empty),
+        height as the sherd lies [m] (the archival analysis's parallax; default thickness) and
+        the vessel's diameter with its 1-sigma uncertainty [m] ((0, 0): not told, empty)."""
         self._wrist[seq] = (length * 1000.0, width * 1000.0, height or thickness)
+        told = diameter[0] > 0 and diameter[1] > 0
         self.catalogue.record_dimensions(
             self._id(seq),
             length * 1000.0,
             width * 1000.0,
             thickness * 1000.0 if thickness > 0 else None,
+            vessel_diameter_mm=(diameter[0] * 1000.0, diameter[1] * 1000.0) if told else None,
         )
 
     def mass(self, seq, kg: float, stable: bool = True, seconds: float = None):

@@ -472,6 +472,11 @@ def _sherd_row(r, folder, archive_root, file_mode):
     else:
         colour = '<span class="nm">%s</span>' % NOT_MEASURED
     size = "%s × %s × %s" % (_num(r, "length_mm"), _num(r, "width_mm"), _num(r, "thickness_mm"))
+    if r.get("vessel_diameter_mm"):
+        size += '<div class="small">vessel Ø %.0f ± %.0f mm</div>' % (
+            r["vessel_diameter_mm"],
+            r["vessel_diameter_sigma_mm"],
+        )
     row = (
         '<tr class="%s"><td class="find"><b>%s</b><div class="small">%s</div></td><td>%s</td>'
         '<td>%s</td><td class="num">%s</td><td class="num">%s<div class="small">%s</div></td>'

@@ -38,6 +38,8 @@ class Observation:
     colour: Tuple[float, float, float] = (0.0, 0.0, 0.0)
     score: float = 1.0
     thickness: float = 0.0  # wall thickness from depth (0 = not measured)
+    vessel_diameter: float = 0.0  # the vessel's outer diameter from the curvature (0 = not told)
+    vessel_diameter_sigma: float = 0.0  # its 1-sigma uncertainty
 
     def distance_to(self, x: float, y: float) -> float:
         return math.hypot(self.x - x, self.y - y)

@@ -63,6 +63,8 @@ def observation_from_msg(s) -> rig.Observation:
         width=s.width,
         height=s.height,
         thickness=s.thickness,
+        vessel_diameter=s.vessel_diameter,
+        vessel_diameter_sigma=s.vessel_diameter_sigma,
         grasp_x=s.grasp_pose.position.x,
         grasp_y=s.grasp_pose.position.y,
         grasp_z=s.grasp_pose.position.z,

@@ -70,7 +70,14 @@ class SherdRecord:
 
     # -- catalogue writes (each commits) ---------------------------------------------------------
     def record_dimensions(self, o: Observation):
-        self.batch.recorder.dimensions(self.seq, o.length, o.width, o.thickness, o.height)
+        self.batch.recorder.dimensions(
+            self.seq,
+            o.length,
+            o.width,
+            o.thickness,
+            o.height,
+            diameter=(o.vessel_diameter, o.vessel_diameter_sigma),
+        )
 
     def record_mass(self, kg: float, stable: bool = True):
         """A settled mass (stations.ScaleStation's rule); an unstable one is never recorded."""

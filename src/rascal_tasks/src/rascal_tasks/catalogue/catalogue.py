@@ -60,8 +60,8 @@ _SEQ_RETRIES = 5
 
 _SHERD_COLUMNS = (
     "sherd_id, s.context_id, c.site_id, seq, status::text AS status, mass_g, mass_missing_reason, "
-    "length_mm, "
-    "width_mm, thickness_mm, colour_munsell, colour_l, colour_a, colour_b, chart_delta_e00, "
+    "length_mm, width_mm, thickness_mm, vessel_diameter_mm, vessel_diameter_sigma_mm, "
+    "colour_munsell, colour_l, colour_a, colour_b, chart_delta_e00, "
     "px_per_cm, image_path, image_sha256, drops, grasp_attempts, pickup_x_m, pickup_y_m, "
     "t_pick_s, t_weigh_s, t_photo_s, t_discard_s, t_locomotion_s, t_grasping_s, "
     "t_data_collection_s, t_perception_s, lost_reason, notes, rig, software_version, "
@@ -715,8 +715,12 @@ class Catalogue:
             {"reason": reason},
         )
 
-    def record_dimensions(self, sherd_id, length_mm, width_mm, thickness_mm=None):
-        """Size from perception [mm]; any unfinished state, no state change."""
+    def record_dimensions(
+        self, sherd_id, length_mm, width_mm, thickness_mm=None, vessel_diameter_mm=None
+    ):
+        """Size from perception [mm]; any unfinished state, no state change.
+        `vessel_diameter_mm`: (diameter, 1-sigma uncertainty) or None (not told)."""
+        diameter, sigma = vessel_diameter_mm or (None, None)
         f = {
             "length_mm": check_number(
                 "length_mm", length_mm, 0.0, 2000.0, "mm", allow_none=False, lo_open=True
@@ -726,6 +730,12 @@ class Catalogue:
             ),
             "thickness_mm": check_number(
                 "thickness_mm", thickness_mm, 0.0, 500.0, "mm", lo_open=True
+            ),
+            "vessel_diameter_mm": check_number(
+                "vessel_diameter_mm", diameter, 0.0, 5000.0, "mm", lo_open=True
+            ),
+            "vessel_diameter_sigma_mm": check_number(
+                "vessel_diameter_sigma_mm", sigma, 0.0, 5000.0, "mm", lo_open=True
             ),
         }
         return self._advance(sherd_id, "measured", UNFINISHED, f, None, f)

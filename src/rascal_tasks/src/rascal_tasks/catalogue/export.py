@@ -39,6 +39,8 @@ PRECISION = {
     "length_mm": 1,
     "width_mm": 1,
     "thickness_mm": 1,
+    "vessel_diameter_mm": 0,
+    "vessel_diameter_sigma_mm": 0,
     "colour_l": 1,
     "colour_a": 1,
     "colour_b": 1,
@@ -66,6 +68,7 @@ def rounded(name, value):
 _SELECT = (
     "SELECT s.context_id || '-' || s.seq AS find_id, c.site_id, s.context_id, s.seq, "
     "s.status::text AS status, mass_g, mass_missing_reason, length_mm, width_mm, thickness_mm, "
+    "vessel_diameter_mm, vessel_diameter_sigma_mm, "
     "colour_munsell, "
     "colour_l, colour_a, colour_b, chart_delta_e00, px_per_cm, image_path, image_sha256, drops, "
     "grasp_attempts, pickup_x_m, pickup_y_m, t_pick_s, t_weigh_s, t_photo_s, t_discard_s, "

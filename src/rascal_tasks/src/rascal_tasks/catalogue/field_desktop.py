@@ -132,6 +132,11 @@ def _description(rec):
         parts.append("lost during recording: %s" % rec["lost_reason"])
     if rec["mass_g"] is None and rec.get("mass_missing_reason"):
         parts.append("no mass: %s" % rec["mass_missing_reason"])
+    if rec.get("vessel_diameter_mm"):
+        parts.append(
+            "vessel diameter about %.0f ± %.0f mm (from the sherd's curvature)"
+            % (rec["vessel_diameter_mm"], rec["vessel_diameter_sigma_mm"])
+        )
     if rec.get("drops"):
         parts.append(
             "dropped %d time%s by the gripper" % (rec["drops"], "" if rec["drops"] == 1 else "s")

@@ -38,6 +38,8 @@ COLUMNS = [
     ("length_mm", "float", "maximum length [mm]"),
     ("width_mm", "float", "maximum width across the length [mm]"),
     ("thickness_mm", "float", "wall thickness [mm]"),
+    ("vessel_diameter_mm", "float", "the vessel's outer diameter from the sherd's curvature [mm]"),
+    ("vessel_diameter_sigma_mm", "float", "its 1-sigma uncertainty [mm]"),
     ("colour_munsell", "text", "Munsell notation of the photographed face, e.g. 5YR 6/4"),
     ("colour_l", "float", "CIE L* (D50) of the photographed face"),
     ("colour_a", "float", "CIE a* (D50)"),
