@@ -45,8 +45,6 @@ class World:
         self.named: List[str] = []  # named poses gone to (park: "sleep")
         self.refuse = lambda x, y, z, yaw, linear: None
         self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
-        self.nudges: Dict[str, tuple] = {}  # sherd name -> (neighbour, dx, dy) its grasp pushes
-        self.detections = 0  # wrist camera detections made
         self.camera_refusals = 0  # captures to refuse before one succeeds
         self.tare = 0.0
 
@@ -107,10 +105,6 @@ class _Gripper(rig.Gripper):
         for s in self.w.lying(st.name if st else None):
             if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.height:
                 self.w.held, self.w.grasped_at = s, (x, y)
-                if s.name in self.w.nudges:  # a finger pushed a neighbour aside
-                    name, dx, dy = self.w.nudges.pop(s.name)
-                    other = next(o for o in self.w.sherds if o.name == name)
-                    self.w.put(other, other.x + dx, other.y + dy)
                 return rig.GraspResult(True, s.width)
         return rig.GraspResult(False, 0.030)
 
@@ -139,7 +133,6 @@ class _Perception(rig.Perception):
         self.calibrated.append(station)
 
     def detect(self, station):
-        self.w.detections += 1
         x, y, _, yaw = self.w.at
         cx, cy = x + CAMERA_OFFSET * math.cos(yaw), y + CAMERA_OFFSET * math.sin(yaw)
         surface = self.w.config.stations[station].surface_z
@@ -216,7 +209,6 @@ class Row:
     image: Optional[str] = None
     lost_reason: Optional[str] = None
     drops: int = 0
-    attempts: int = 1  # grasps it took to pick it up
     notes: List[str] = field(default_factory=list)
 
 
@@ -248,7 +240,7 @@ class Recorder:
 
     def new_sherd(self, pickup_xy, attempts=1):
         seq = max(self.sherds, default=0) + 1
-        self.sherds[seq] = Row(seq, pickup_xy=tuple(pickup_xy), attempts=attempts)
+        self.sherds[seq] = Row(seq, pickup_xy=tuple(pickup_xy))
         self.writes.append(("picked", seq))
         return seq
 

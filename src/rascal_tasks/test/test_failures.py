@@ -91,31 +91,6 @@ def test_two_sherds_end_in_done(config):
     assert world.named == ["sleep"]
 
 
-def test_a_neighbour_nudged_by_a_grasp_is_looked_at_again_before_its_own(config):
-    # b lies 60 mm from a: a's fingers push it 15 mm aside. Its survey detection is stale, so
-    # it is looked at again and grasped where it lies now, at the first try; c, far from both,
-    # is grasped from the survey's view (no extra look).
-    world = World(
-        config,
-        [Sherd("a", 0.10, 0.22), Sherd("b", 0.16, 0.22), Sherd("c", 0.28, 0.31)],
-    )
-    world.nudges["a"] = ("b", 0.015, 0.0)
-    outcome, batch, rec = _run(config, world)
-    assert outcome == "finished"
-    assert rec.status() == {1: "done", 2: "done", 3: "done"}
-    assert [rec.sherds[s].attempts for s in (1, 2, 3)] == [1, 1, 1]
-    assert rec.sherds[2].pickup_xy == pytest.approx((0.175, 0.22))
-
-
-def test_without_a_disturbance_no_sherd_is_looked_at_twice(config):
-    world = World(config, [Sherd("a", 0.04, 0.20), Sherd("b", 0.28, 0.31)])
-    _run(config, world)
-    looks = world.detections
-    world = World(config, [Sherd("a", 0.04, 0.20), Sherd("b", 0.14, 0.20)])  # within reach
-    _run(config, world)
-    assert world.detections == looks + 1  # b once more, after a's grasp
-
-
 def test_an_unreachable_sherd_is_lost_and_the_next_one_is_recorded(config):
     # a slips on its way to the scale and falls back into the pickup area, where the arm cannot
     # reach down to it

@@ -49,8 +49,6 @@ class Batch:
         self.misses = {}  # rounded (x, y) -> pickups that failed there
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
         self.pending: List[Observation] = []
-        # where the gripper went down on the pickup area since the pending detections were made
-        self.disturbed: List[tuple] = []
         self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
         self.empty_surveys = 0
         self.stop_reason: Optional[str] = None  # detail of the last STOPPING_EVENTS event

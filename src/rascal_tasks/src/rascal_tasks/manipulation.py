@@ -40,8 +40,6 @@ def grasp(b, o: Observation, station) -> bool:
     with b.phase("grasping"):
         b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
     approach = o.grasp_z + b.config["arm"]["approach_offset"]
-    if station is b.pickup:  # the fingers may nudge what lies around: those views are stale
-        b.disturbed.append((o.grasp_x, o.grasp_y))
     with _aiming_at(o, station):
         b.move_down(o.grasp_x, o.grasp_y, approach, o.grasp_yaw)
         b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)

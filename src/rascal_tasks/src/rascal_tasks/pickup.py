@@ -1,13 +1,10 @@
 """PICKUP: the next sherd of the survey is grasped from the pickup area and, once it is in the
-gripper, numbered. A detection made before a grasp went down near it is stale (the fingers may
-have nudged it): the sherd is looked at again first, so no grasp aims at an old view. No ROS
-in here.
+gripper, numbered. No ROS in here.
 """
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.survey import fresh_view, seen_since_disturbed
 
 
 class Pickup(BatchState):
@@ -20,15 +17,7 @@ class Pickup(BatchState):
 
     def run(self):
         b = self.batch
-        o = b.pending.pop(0)
-        if not seen_since_disturbed(b, o):
-            seen = fresh_view(b, o)
-            if seen is None:  # it is not where the survey saw it: the mat changed, survey again
-                b.event(None, "moved", "no sherd at (%.3f, %.3f) m any more" % (o.x, o.y))
-                b.pending = []
-                return "missed"
-            o = seen
-        o, tries, held = grasp_retrying(b, o, b.pickup)
+        o, tries, held = grasp_retrying(b, b.pending.pop(0), b.pickup)
         if held:
             b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
             return "held"

@@ -3,7 +3,7 @@ and the states SURVEY and SURVEY_NEXT. No ROS in here.
 """
 
 import math
-from typing import List, Optional, Tuple
+from typing import List, Tuple
 
 from rascal_workcell import urdf_model
 
@@ -16,10 +16,6 @@ from rascal_tasks.selection import in_pick_order
 CAMERA_OFFSET = urdf_model.camera_offset()
 # Two detections closer than this are the same sherd seen from two survey poses.
 SAME_SHERD = 0.02
-# [m] a grasp on the pickup area may have nudged the sherds whose centres lie this near: the
-# fingers open up to 74 mm across the grasp (facts §1.4) and a neighbour reaches up to half its
-# length (sherds up to ~100 mm) towards them. Their survey detections are then stale.
-DISTURBED_WITHIN = 0.10
 
 
 def lawnmower(
@@ -57,23 +53,6 @@ def survey_at(b, station, x, y) -> List[Observation]:
         return b.rig.perception.detect(station.name)
 
 
-def seen_since_disturbed(b, o: Observation) -> bool:
-    """Is the detection `o` (from the last survey) still what lies there: no grasp on the pickup
-    area since the survey went down near it?"""
-    return all(o.distance_to(x, y) > DISTURBED_WITHIN for x, y in b.disturbed)
-
-
-def fresh_view(b, o: Observation) -> Optional[Observation]:
-    """`o` seen again from above (the wrist camera over where it was): the detection nearest
-    it within recovery.search_radius, or None when nothing lies there any more."""
-    near = [
-        c
-        for c in survey_at(b, b.pickup, o.x, o.y)
-        if c.distance_to(o.x, o.y) < b.config["recovery"]["search_radius"]
-    ]
-    return min(near, key=lambda c: c.distance_to(o.x, o.y)) if near else None
-
-
 def merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
     """Add to `found` the detections of `new` that are not a sherd already in it."""
     for o in new:
@@ -107,7 +86,6 @@ class Survey(BatchState):
             return self.run()
         b.empty_surveys = 0
         b.pending = in_pick_order(found, b.config["perception"]["selection_policy"])
-        b.disturbed = []
         return "found"
 
 
