@@ -112,6 +112,7 @@ def test_json_on_stdout_is_one_list_of_sherds_however_asked(tmp_path, args):
     assert isinstance(sherds, list) and len(sherds) == photo_result(photo)["sherd_count"] >= 1
     for s in sherds:
         assert s["px_per_cm"] == photo_result(photo)["px_per_cm"]
+        assert s["scale"] == "%.2f px/cm" % s["px_per_cm"]
         assert s["length_mm"] >= s["width_mm"] > 0 and isinstance(s["flags"], list)
     assert not list(tmp_path.iterdir())  # the photo's name was not taken for a JSON file
 

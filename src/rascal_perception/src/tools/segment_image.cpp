@@ -32,7 +32,8 @@ const char* kHelp =
     "\n"
     "options:\n"
     "  --json [FILE], -j    the sherds as one JSON list, one object per sherd (id, length_mm,\n"
-    "                       width_mm, area_mm2, px_per_cm, flags, centre_px, box_px, angle_deg,\n"
+    "                       width_mm, area_mm2, px_per_cm, scale (\"12.10 px/cm\"), flags,\n"
+    "                       centre_px, box_px, angle_deg,\n"
     "                       area_px, colour): on stdout (no FILE, or '-'), else written to FILE as\n"
     "                       well as what stdout holds; a FILE not ending in .json needs --json=FILE\n"
     "  --report [FILE]      the whole result as one JSON object (summary, px/cm, the scale bar's\n"
@@ -132,6 +133,11 @@ std::string summaryOf(const PhotoResult& r) {
   return summary + (d.empty() ? "" : " (doubtful: exit 1)");
 }
 
+void twoDecimals(std::ostream& o) {
+  o.setf(std::ios::fixed);
+  o.precision(2);
+}
+
 /// One sherd as a JSON object: what a catalogue wants first (sizes, scale, flags), then pixels.
 void sherdJson(const PhotoResult& r, size_t i, std::ostream& o) {
   const PhotoSherd& s = r.sherds[i];
@@ -139,9 +145,10 @@ void sherdJson(const PhotoResult& r, size_t i, std::ostream& o) {
   o << "{\"id\": " << i + 1;
   if (r.bar.found) {
     o << ", \"length_mm\": " << s.length_mm << ", \"width_mm\": " << s.width_mm << ", \"area_mm2\": " << s.area_mm2
-      << ", \"px_per_cm\": " << r.bar.px_per_cm;
+      << ", \"px_per_cm\": " << r.bar.px_per_cm << ", \"scale\": \"" << r.bar.px_per_cm << " px/cm\"";
   } else {
-    o << ", \"length_mm\": null, \"width_mm\": null, \"area_mm2\": null, \"px_per_cm\": null";
+    o << ", \"length_mm\": null, \"width_mm\": null, \"area_mm2\": null, \"px_per_cm\": null, "
+         "\"scale\": \"no scale bar\"";
   }
   o << ", \"flags\": [";
   const std::vector<std::string> f = flagNames(s.flags);
@@ -155,8 +162,7 @@ void sherdJson(const PhotoResult& r, size_t i, std::ostream& o) {
 /// `--json`: the sherds as one JSON list on one line, the shape tools that read lists expect.
 std::string sherdList(const PhotoResult& r) {
   std::ostringstream o;
-  o.setf(std::ios::fixed);
-  o.precision(2);
+  twoDecimals(o);
   o << "[";
   for (size_t i = 0; i < r.sherds.size(); ++i) {
     o << (i ? ", " : "");
@@ -169,8 +175,7 @@ std::string sherdList(const PhotoResult& r) {
 /// `--report`: the whole result, the photo-wide findings beside the sherds.
 std::string report(const std::string& image, const cv::Mat& rgb, const PhotoResult& r) {
   std::ostringstream o;
-  o.setf(std::ios::fixed);
-  o.precision(2);
+  twoDecimals(o);
   o << "{\n  \"image\": \"" << escape(image) << "\",\n  \"summary\": \"" << escape(summaryOf(r))
     << "\",\n  \"sherd_count\": " << r.sherds.size() << ",\n  \"width\": " << rgb.cols << ",\n  \"height\": " << rgb.rows
     << ",\n";
