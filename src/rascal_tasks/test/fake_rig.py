@@ -14,6 +14,7 @@ from typing import Dict, List, Optional
 
 from rascal_tasks import rig
 from rascal_tasks.catalogue.errors import StatusError
+from rascal_tasks.sorting import SherdValues, choose_bin
 from rascal_tasks.survey import CAMERA_OFFSET
 
 VIEW_RADIUS = 0.15  # m around the wrist camera's axis
@@ -210,6 +211,8 @@ class Row:
     lost_reason: Optional[str] = None
     drops: int = 0
     notes: List[str] = field(default_factory=list)
+    size: tuple = (None, None, None)  # length, width, thickness [m] the wrist camera measured
+    bin: Optional[str] = None
 
 
 class Recorder:
@@ -245,7 +248,21 @@ class Recorder:
         return seq
 
     def dimensions(self, seq, length, width, thickness, height=None, diameter=(0.0, 0.0)):
+        self.sherds[seq].size = (length, width, thickness or None)
         self.writes.append(("dimensions", seq))
+
+    def sort(self, seq, bins, default, wait_for_photo=False):
+        """The catalogue's sorting (Recorder.sort) on this row; no colour: no photo analysis."""
+        row = self.sherds[seq]
+        values = SherdValues(
+            *row.size,
+            mass=row.mass,
+            flags=frozenset(["dropped"] * bool(row.drops) + ["mass_unstable"] * (row.mass is None)),
+        )
+        decision = choose_bin(bins, default, values)
+        row.bin = decision.bin
+        self.writes.append(("sorted", seq, decision.bin))
+        return decision
 
     def mass(self, seq, kg, stable=True, seconds=None):
         assert stable, "an unstable reading is never recorded as a mass"

@@ -55,6 +55,27 @@ TEST(Workcell, DiscardWallsHaveOneThicknessAndCloseTheBox) {
   EXPECT_NEAR(py->centre.y(), -0.31 + 0.13 / 2, 1e-12);
 }
 
+TEST(Workcell, SortingBinsAreBoxesBesideTheOneDiscardBox) {
+  YAML::Node n = shipped();
+  YAML::Node bin(YAML::NodeType::Map);
+  bin["type"] = "bin";
+  bin["position"] = std::vector<double>{0.14, -0.13};
+  bin["size"] = std::vector<double>{0.10, 0.08};
+  bin["surface_z"] = 0.0;
+  bin["wall_height"] = 0.03;
+  bin["rule"] = "length >= 60 mm";
+  n["stations"]["large"] = bin;
+  const Workcell w = Workcell::fromParameters(Parameters(n, "sim"));
+  EXPECT_EQ(w.find("large")->type, StationType::Bin);
+  EXPECT_EQ(w.station(StationType::Discard).name, "discard");  // still exactly one
+  const auto boxes = w.collisionBoxes();
+  const FixtureBox* px = box(boxes, "bin large wall +x");
+  ASSERT_NE(px, nullptr);
+  EXPECT_EQ(px->station, "large");
+  EXPECT_NEAR(px->centre.x(), 0.14 + 0.05, 1e-12);
+  EXPECT_DOUBLE_EQ(px->size.z(), 0.03);
+}
+
 TEST(Workcell, ScalePlatformIsASupportOnItsHousing) {
   const auto boxes = Workcell::fromParameters(Parameters(shipped(), "sim")).collisionBoxes();
   const FixtureBox* platform = box(boxes, "scale platform");

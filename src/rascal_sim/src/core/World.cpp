@@ -38,7 +38,9 @@ Eigen::Vector3d fixtureColour(const WorldLayout& l, const FixtureBox& b) {
   const Station* s = l.workcell.find(b.station);
   if (s && s->type == StationType::Scale) return l.scale_colours[1] * 0.8;  // housing
   if (s && s->type == StationType::ArchivalCamera) return {0.3, 0.3, 0.32};  // stand
-  if (s && s->type == StationType::Discard) return {0.45, 0.40, 0.33};       // box walls
+  if (s && (s->type == StationType::Discard || s->type == StationType::Bin)) {
+    return {0.45, 0.40, 0.33};  // box walls
+  }
   return {0.5, 0.5, 0.5};
 }
 
@@ -188,7 +190,7 @@ struct World::Impl {
     m.addRect(0.25, 0.0, 1.3, 1.5, 0.0, l.table_colour);
     const double mz = 0.0004;
     for (const Station& s : l.workcell.stations()) {
-      if (s.type == StationType::Pickup || s.type == StationType::Discard) {
+      if (s.type == StationType::Pickup || s.type == StationType::Discard || s.type == StationType::Bin) {
         m.addRect(s.area.centre.x(), s.area.centre.y(), s.area.size.x(), s.area.size.y(), mz, l.mat_colour);
       }
     }

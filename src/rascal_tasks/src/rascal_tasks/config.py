@@ -26,6 +26,7 @@ import yaml
 
 from rascal_workcell import schema, urdf_model
 
+from rascal_tasks.sorting import Rule, RuleError, parse_rule
 from rascal_tasks.stations import STATION_PLUGINS
 from rascal_tasks.survey import lawnmower
 
@@ -98,11 +99,12 @@ class Station:
     area: Rect
     surface_z: float
     place_at: Tuple[float, float]  # where a sherd is put (the centre unless the config says)
-    wall_height: float = 0.0  # discard box walls
+    wall_height: float = 0.0  # discard box and sorting bin walls
     camera_height: float = 0.0  # archival camera lens above the surface
     colour_chart: Optional[Fixture] = None
     scale_bar: Optional[Fixture] = None
     stand: Optional[Fixture] = None
+    rule: Optional[Rule] = None  # a sorting bin's (sorting.py)
 
 
 @dataclass(frozen=True)
@@ -118,8 +120,13 @@ class Config:
         return self.data[key]
 
     def station_order(self) -> List[str]:
-        """Stations a sherd visits after pickup, in config order."""
-        return [n for n, s in self.stations.items() if s.type != "pickup"]
+        """Stations a sherd visits after pickup, in config order (a sorting bin only when its
+        rule takes the sherd, in place of the discard box)."""
+        return [n for n, s in self.stations.items() if s.type not in ("pickup", "bin")]
+
+    def bins(self) -> List[Tuple[str, Rule]]:
+        """The sorting bins (name, rule) in the order their rules are tried."""
+        return [(n, s.rule) for n, s in self.stations.items() if s.type == "bin"]
 
     def resolve(self, path: str) -> str:
         """A path from the config, relative paths taken from the workspace root."""
@@ -243,7 +250,7 @@ def _rect(section: dict) -> Rect:
 
 def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
     stations: Dict[str, Station] = {}
-    types = ("pickup",) + tuple(STATION_PLUGINS)
+    types = ("pickup",) + tuple(STATION_PLUGINS) + ("bin",)
     for name, st in sec.items():
         key = "stations." + name
         type_ = st["type"]
@@ -283,8 +290,13 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
                 )
         else:
             place_at = area.center
-            if type_ == "discard":
+            if type_ in ("discard", "bin"):
                 extra["wall_height"] = st["wall_height"]
+            if type_ == "bin":
+                try:
+                    extra["rule"] = parse_rule(st["rule"])
+                except RuleError as e:
+                    _fail(source, key + ".rule", str(e), st["rule"])
             for cx, cy in area.corners():
                 if not top_down_reachable(cx, cy, surface_z):
                     _fail(

@@ -13,6 +13,7 @@ from rascal_tasks.catalogue import ArchiveError, Catalogue, ImageArchive, repair
 from rascal_tasks.catalogue.archive import make_dirs, owner_tag
 from rascal_tasks.catalogue.context_id import context_folder
 from rascal_tasks.catalogue.errors import FieldError
+from rascal_tasks.sorting import SherdValues, choose_bin
 
 DEFAULT_MIN_FREE_MB = 1000  # archive.min_free_mb's default in the parameter schema
 ANALYSIS_WAIT = 120.0  # [s] longest wait for a photo's analysis when the sherd is done
@@ -282,6 +283,17 @@ class Recorder:
             self.log("sherd %d archival: %s" % (seq, note))
         if row["status"] in FINAL_STATUSES:
             self.catalogue.refresh_sidecar(self._id(seq), self.archive)
+
+    def sort(self, seq, bins, default: str, wait_for_photo: bool = False):
+        """Choose sherd `seq`'s box (sorting.choose_bin) on what the catalogue holds of it,
+        after its photo's analysis when a rule needs its colour (`wait_for_photo`), and record
+        the choice and its reason. Returns the sorting.Decision."""
+        if wait_for_photo:
+            self.finish_analysis(seq)
+        values = SherdValues.from_row(self.catalogue.get(self._id(seq)))
+        decision = choose_bin(bins, default, values)
+        self.catalogue.record_bin(self._id(seq), decision.bin, decision.reason)
+        return decision
 
     def done(self, seq, seconds: float = None, timings: dict = None):
         pending = self._pending.get(seq)

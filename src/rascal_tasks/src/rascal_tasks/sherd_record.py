@@ -30,6 +30,7 @@ class SherdRecord:
         self.picked_xy: Optional[tuple] = None  # where it was picked (None: unknown on resume)
         self.drops = 0
         self.mass: Optional[float] = None
+        self.bin: Optional[str] = None  # the sorting bin it goes into (stations.DiscardStation)
         # The batch's timings since the last sherd ended: surveying counts for this one.
         self.timings: Timings = batch.timings
 

@@ -21,7 +21,7 @@ class Translate(BatchState):
 
     def run(self):
         b = self.batch
-        st = b.config.stations[b.station_names[self.index]]
+        st = b.plugins[self.index].target(b.sherd)
         b.move_down(*st.place_at, b.travel_z(), b.sherd.grasp_yaw)
         if not b.rig.gripper.holding():
             b.sherd.dropped("while carrying to %s" % st.name)
@@ -42,8 +42,8 @@ class Place(BatchState):
     def run(self):
         b = self.batch
         plugin = b.plugins[self.index]
-        st = plugin.station
         s = b.sherd
+        st = plugin.target(s)
         plugin.before_place(s)
         if not plugin.release_from_above:
             z = st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]

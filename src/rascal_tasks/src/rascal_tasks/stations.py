@@ -47,6 +47,11 @@ class StationPlugin:
         self.station = station  # rascal_tasks.config.Station
         self.batch = batch  # rascal_tasks.batch.Batch
 
+    def target(self, sherd):
+        """The station the sherd is carried to and set down at: this one (the discard station
+        may send it to a sorting bin instead)."""
+        return self.station
+
     def before_place(self, sherd) -> None:
         """Called with the sherd (a SherdRecord) in the gripper above the station (e.g. tare
         the scale)."""
@@ -239,10 +244,31 @@ class ArchivalCameraStation(StationPlugin):
 
 @station_type("discard")
 class DiscardStation(StationPlugin):
-    """Nothing to measure: the sherd is done once it is in the box (the last station)."""
+    """Nothing to measure: the sherd is done once it is in the box (the last station). With
+    sorting bins configured (stations of type bin, sorting.py) the box is the one whose rule
+    holds for what the catalogue recorded of the sherd, this station's box when none does; the
+    choice and its reason are recorded before the sherd is carried there. A rule on colour
+    waits for the sherd's archival analysis (recorder.ANALYSIS_WAIT at most)."""
 
     status = "done"
     release_from_above = True
+
+    def target(self, sherd):
+        b = self.batch
+        bins = b.config.bins()
+        if not bins:
+            return self.station
+        if sherd.bin is None:
+            with b.phase("data_collection"):
+                decision = b.recorder.sort(
+                    sherd.seq,
+                    bins,
+                    self.station.name,
+                    wait_for_photo=any(rule.needs_colour for _, rule in bins),
+                )
+            sherd.bin = decision.bin
+            b.event(sherd, "sorted", decision.reason)
+        return b.config.stations[sherd.bin]
 
     def after_place(self, sherd):
         return "done"

@@ -12,11 +12,12 @@
 
 namespace rascal_workcell {
 
+/// Bin: a sorting box like the discard box (walls, a mat), for the sherds its rule picks.
 /// Other: a station type of a task-layer plug-in (a profile scanner): a place on the table the
 /// nodes know by its area and surface only.
-enum class StationType { Pickup, Scale, ArchivalCamera, Discard, Other };
+enum class StationType { Pickup, Scale, ArchivalCamera, Discard, Bin, Other };
 
-/// "pickup" | "scale" | "archival_camera" | "discard" (the config's `type`).
+/// "pickup" | "scale" | "archival_camera" | "discard" | "bin" (the config's `type`).
 std::string toString(StationType type);
 StationType stationTypeFromString(const std::string& name);  ///< Other for any other name
 
@@ -43,7 +44,7 @@ struct Station {
   TableRect area;                 ///< the mat, platform, field of view or box floor
   double surface_z = 0.0;         ///< [m] top surface above the table
   Eigen::Vector2d place_at{0.0, 0.0};  ///< where a sherd is put (the centre unless configured)
-  // discard box
+  // discard box and sorting bins
   double wall_height = 0.0;       ///< [m] walls above the table
   // archival camera
   double camera_height = 0.0;     ///< [m] lens above the surface
@@ -72,7 +73,8 @@ class Workcell {
   const Station* find(const std::string& name) const;
 
   /// Everything standing on the table the arm must not hit, computed once: the scale housing and
-  /// its platform, the four discard box walls, the camera stand's post.
+  /// its platform, the four walls of the discard box and of each sorting bin, the camera
+  /// stand's post.
   std::vector<FixtureBox> collisionBoxes() const;
   /// Flat marks lying on the table that perception must not take for sherds: chart and bar.
   std::vector<TableRect> flatFixtures() const;

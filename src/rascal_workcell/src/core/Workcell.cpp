@@ -10,6 +10,7 @@ std::string toString(StationType type) {
     case StationType::Scale: return "scale";
     case StationType::ArchivalCamera: return "archival_camera";
     case StationType::Discard: return "discard";
+    case StationType::Bin: return "bin";
     case StationType::Other: return "other";
   }
   return "unknown";
@@ -17,7 +18,7 @@ std::string toString(StationType type) {
 
 StationType stationTypeFromString(const std::string& name) {
   for (StationType t : {StationType::Pickup, StationType::Scale, StationType::ArchivalCamera,
-                        StationType::Discard}) {
+                        StationType::Discard, StationType::Bin}) {
     if (toString(t) == name) return t;
   }
   return StationType::Other;
@@ -47,10 +48,10 @@ Workcell Workcell::fromParameters(const Parameters& p) {
       s.scale_bar = rect("scale_bar.");
       s.stand = rect("stand.");
       s.stand_height = p.number(key + "stand.height");
-    } else if (s.type == StationType::Discard) {
+    } else if (s.type == StationType::Discard || s.type == StationType::Bin) {
       s.wall_height = p.number(key + "wall_height");
       if ((s.area.size.array() <= 2.0 * kDiscardWallThickness).any()) {
-        throw ParameterError(key + "size: the discard box must be wider than its two walls (" +
+        throw ParameterError(key + "size: the box must be wider than its two walls (" +
                              std::to_string(2.0 * kDiscardWallThickness) + " m)");
       }
     }
@@ -105,14 +106,16 @@ std::vector<FixtureBox> Workcell::collisionBoxes() const {
         }
         break;
       }
-      case StationType::Discard: {
+      case StationType::Discard:
+      case StationType::Bin: {
         // Four walls centred on the box outline; the long ones overlap the corners.
         const double w = kDiscardWallThickness, h = s.wall_height;
         if (h <= 0.0) break;
-        boxes.push_back({"discard box wall +y", s.name, {c.x(), c.y() + d.y() / 2, h / 2}, {d.x() + w, w, h}, false});
-        boxes.push_back({"discard box wall -y", s.name, {c.x(), c.y() - d.y() / 2, h / 2}, {d.x() + w, w, h}, false});
-        boxes.push_back({"discard box wall +x", s.name, {c.x() + d.x() / 2, c.y(), h / 2}, {w, d.y() + w, h}, false});
-        boxes.push_back({"discard box wall -x", s.name, {c.x() - d.x() / 2, c.y(), h / 2}, {w, d.y() + w, h}, false});
+        const std::string box = s.type == StationType::Bin ? "bin " + s.name : "discard box";
+        boxes.push_back({box + " wall +y", s.name, {c.x(), c.y() + d.y() / 2, h / 2}, {d.x() + w, w, h}, false});
+        boxes.push_back({box + " wall -y", s.name, {c.x(), c.y() - d.y() / 2, h / 2}, {d.x() + w, w, h}, false});
+        boxes.push_back({box + " wall +x", s.name, {c.x() + d.x() / 2, c.y(), h / 2}, {w, d.y() + w, h}, false});
+        boxes.push_back({box + " wall -x", s.name, {c.x() - d.x() / 2, c.y(), h / 2}, {w, d.y() + w, h}, false});
         break;
       }
       case StationType::ArchivalCamera:

@@ -27,6 +27,7 @@ import contextlib
 import datetime
 import json
 import logging
+import re
 import threading
 import time
 import uuid
@@ -64,7 +65,7 @@ _SHERD_COLUMNS = (
     "colour_munsell, colour_l, colour_a, colour_b, chart_delta_e00, "
     "px_per_cm, image_path, image_sha256, drops, grasp_attempts, pickup_x_m, pickup_y_m, "
     "t_pick_s, t_weigh_s, t_photo_s, t_discard_s, t_locomotion_s, t_grasping_s, "
-    "t_data_collection_s, t_perception_s, lost_reason, notes, rig, software_version, "
+    "t_data_collection_s, t_perception_s, lost_reason, bin, notes, rig, software_version, "
     "config_hash, picked_at, weighed_at, photographed_at, done_at, lost_at, updated_at"
 )
 
@@ -831,6 +832,15 @@ class Catalogue:
         if archive is not None:
             self.refresh_sidecar(sherd_id, archive)
         return result
+
+    def record_bin(self, sherd_id, bin_name, reason=None):
+        """The box the sherd is put into (the discard station or a sorting bin) and why (the
+        `sorted` event); no state change. Before it is done: a resumed sherd is sorted again."""
+        f = {"bin": check_text("bin", bin_name, 64, allow_none=False)}
+        if not re.match(r"^[A-Za-z0-9_]{1,64}$", f["bin"]):
+            raise FieldError("bin %r: must be a station name (letters, digits, _)" % bin_name)
+        detail = {"bin": f["bin"], "reason": check_text("reason", (reason or "")[:500], 500)}
+        return self._advance(sherd_id, "sorted", UNFINISHED, f, None, detail)
 
     def record_lost(self, sherd_id, reason, timings=None):
         """The sherd could not be found again; any unfinished state -> lost (final)."""

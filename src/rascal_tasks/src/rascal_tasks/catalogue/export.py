@@ -73,7 +73,7 @@ _SELECT = (
     "colour_l, colour_a, colour_b, chart_delta_e00, px_per_cm, image_path, image_sha256, drops, "
     "grasp_attempts, pickup_x_m, pickup_y_m, t_pick_s, t_weigh_s, t_photo_s, t_discard_s, "
     "t_locomotion_s, t_grasping_s, t_data_collection_s, t_perception_s, "
-    "lost_reason, notes, rig, software_version, config_hash, picked_at, weighed_at, "
+    "lost_reason, bin, notes, rig, software_version, config_hash, picked_at, weighed_at, "
     "photographed_at, done_at, lost_at, updated_at "
     "FROM sherds s JOIN contexts c USING (context_id) WHERE s.context_id = %s ORDER BY s.seq"
 )

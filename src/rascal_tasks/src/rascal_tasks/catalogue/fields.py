@@ -61,6 +61,7 @@ COLUMNS = [
     ("t_data_collection_s", "float", "time spent weighing and photographing [s]"),
     ("t_perception_s", "float", "time spent detecting [s]"),
     ("lost_reason", "text", "why it was recorded as lost"),
+    ("bin", "text", "the box it went into: the discard box, or the sorting bin whose rule took it"),
     ("notes", "text", "free text"),
     ("rig", "text", "rig that recorded it"),
     ("software_version", "text", "recording software"),
