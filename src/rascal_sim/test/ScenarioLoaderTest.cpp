@@ -213,3 +213,21 @@ TEST(SherdMeshBuilder, PrincipalAxesOfATurnedRectangle) {
   std::reverse(rect.begin(), rect.end());  // clockwise: the same axes
   EXPECT_NEAR(SherdMeshBuilder::principalAxes(rect).length, 0.06, 1e-9);
 }
+
+TEST(ScenarioLoader, AHeapIsDroppedOntoOneSpotInLayersOnTheMat) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  const Scenario s = loader.parse(
+      "seed: 7\ngenerate: {count: 20, heap: {centre: [0.16, 0.25], spread: 0.03, drop_height: 0.01}}\n");
+  ASSERT_EQ(s.sherds.size(), 20u);
+  const TableRect& mat = f.layout.station(StationType::Pickup).area;
+  int on_another = 0;
+  for (size_t i = 0; i < s.sherds.size(); ++i) {
+    Eigen::Vector2d lo, hi;
+    worldBox(s.sherds[i], lo, hi);
+    EXPECT_TRUE(mat.contains(lo) && mat.contains(hi)) << s.sherds[i].name;
+    if (s.sherds[i].drop_height > 0.01 + 1e-9) ++on_another;  // let go above an earlier sherd
+  }
+  EXPECT_GE(on_another, 10);  // a heap, not a spread: most sherds start on others
+  EXPECT_THROW(loader.parse("generate: {count: 5, heap: {centre: [0.9, 0.0]}}\n"), std::runtime_error);
+}

@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "ShippedConfig.hpp"
+#include "rascal_sim/MunsellTable.hpp"
+#include "rascal_sim/ScenarioLoader.hpp"
 #include "rascal_sim/World.hpp"
 
 using namespace rascal_sim;
@@ -76,4 +78,23 @@ TEST(World, ArmLinkPassingThroughASherdPushesIt) {
   const Eigen::Vector3d after = world.sherd(0).pose.translation();
   EXPECT_GT((after - before).head<2>().norm(), 0.01) << "before " << before.transpose() << " after "
                                                      << after.transpose();
+}
+
+TEST(World, AHeapSettlesInLayersAndStaysOnTheMat) {
+  const MunsellTable munsell(std::string(RASCAL_SIM_DATA_DIR) + "/munsell_soil_hues_grid_renotation.csv");
+  const Scenario s = ScenarioLoader(layout(), munsell)
+                         .parse("seed: 11\ngenerate: {count: 20, heap: {spread: 0.025, drop_height: 0.01}}\n");
+  World world(layout(), gripper());
+  world.spawn(s.sherds);
+  for (int i = 0; i < 4000; ++i) world.step(0.001);
+  const TableRect& mat = layout().station(StationType::Pickup).area;
+  int above = 0;
+  for (size_t i = 0; i < s.sherds.size(); ++i) {
+    const SherdState st = world.sherd(i);
+    const Eigen::Vector3d p = st.pose.translation();
+    EXPECT_TRUE(mat.contains(p.head<2>())) << s.sherds[i].name << " at " << p.transpose();
+    EXPECT_LT(st.linear_velocity.norm(), 0.01) << s.sherds[i].name;
+    if (p.z() > st.box_size.z() / 2 + 0.004) ++above;  // lies on another sherd
+  }
+  EXPECT_GE(above, 5);
 }

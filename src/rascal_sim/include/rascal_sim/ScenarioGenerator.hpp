@@ -1,5 +1,6 @@
 #pragma once
-// Random scenarios: N irregular sherds on a station, seeded, spaced at least a finger apart.
+// Random scenarios: N irregular sherds on a station, seeded, spaced at least a finger apart; or
+// a bag tipped out: the sherds dropped onto one spot, where they settle in layers (a heap).
 #include <Eigen/Geometry>
 #include <random>
 #include <string>
@@ -24,12 +25,24 @@ struct GeneratorOptions {
   double painted_fraction = 0.3;     ///< share of sherds with a painted pattern
   int mesh_count = 0;                ///< how many sherds use the fragment STL instead
   std::string mesh_file;
+  // a heap (heap = true): every sherd dropped around heap_centre instead of laid on a grid
+  bool heap = false;
+  Eigen::Vector2d heap_centre{0.0, 0.0};  ///< [m] where the bag is tipped out (in `area`)
+  double heap_spread = 0.03;          ///< [m] standard deviation of the sherds' centres about it
+  double heap_drop_height = 0.02;     ///< [m] gap under the lowest sherds when they are let go
+  int heap_layers = 3;                ///< no sherd is let go on more than layers - 1 others
 };
 
 class ScenarioGenerator {
  public:
   explicit ScenarioGenerator(const MunsellTable& munsell);
   std::vector<SherdSpec> generate(const GeneratorOptions& options) const;
+  /// The sherds of `generate` re-placed as a heap: centres scattered about the heap's centre
+  /// (kept on the area), each let go just above the sherds already dropped under it, so the
+  /// pile is built at once without two sherds inside each other and settles in layers, at
+  /// most heap_layers deep.
+  static void heapUp(std::vector<SherdSpec>& sherds, const std::vector<Eigen::Vector2d>& extents,
+                     const GeneratorOptions& o, std::mt19937& rng);
   /// An irregular outline with extents length x width, centred on its bounding box.
   static std::vector<Eigen::Vector2d> irregularOutline(double length, double width, std::mt19937& rng);
 

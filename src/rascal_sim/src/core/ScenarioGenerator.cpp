@@ -102,8 +102,9 @@ std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) co
     char name[32];
     std::snprintf(name, sizeof name, "sherd_%02d", i);
     s.name = name;
-    const double max_len = std::max(0.02, cell_long - o.min_spacing);
-    const double max_wid = std::max(0.02, cell_short - o.min_spacing);
+    // on a grid a sherd fits its cell; in a heap sherds lie on each other
+    const double max_len = o.heap ? o.length_max : std::max(0.02, cell_long - o.min_spacing);
+    const double max_wid = o.heap ? o.width_max : std::max(0.02, cell_short - o.min_spacing);
     double length = uniform(rng, std::min(o.length_min, max_len), std::min(o.length_max, max_len));
     double width = uniform(rng, std::min(o.width_min, max_wid), std::min(o.width_max, max_wid));
     width = std::min(width, length);
@@ -147,6 +148,10 @@ std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) co
     extents[i] = Eigen::Vector2d(length, width);
     out.push_back(s);
   }
+  if (o.heap) {
+    heapUp(out, extents, o, rng);
+    return out;
+  }
   // touching pairs: neighbours in a row pushed together along x until their (collision) boxes
   // are 0.2 mm apart
   int pairs = 0;
@@ -166,6 +171,46 @@ std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) co
     ++pairs;
   }
   return out;
+}
+
+void ScenarioGenerator::heapUp(std::vector<SherdSpec>& sherds, const std::vector<Eigen::Vector2d>& extents,
+                               const GeneratorOptions& o, std::mt19937& rng) {
+  std::vector<double> top(sherds.size(), 0.0);  // [m] top of each sherd as let go, above the table
+  std::vector<int> layer(sherds.size(), 0);     // 1: on the mat, 2: on a sherd on the mat, ...
+  for (size_t i = 0; i < sherds.size(); ++i) {
+    SherdSpec& s = sherds[i];
+    // the box the sherd occupies: its wall plus the bend of a shell over its half length
+    // (sag = k r^2 / 2, the simulator's shell), a millimetre more for the outline's corners
+    const double r = extents[i].x() / 2;
+    const double height = s.thickness + 0.5 * (std::abs(s.curvature) + std::abs(s.curvature_long)) * r * r + 0.001;
+    // where it falls: about the heap's centre, on the mat, never deeper than heap_layers (a
+    // sherd that would come to lie higher rolls off the pile: drawn again, a little wider)
+    double spread = o.heap_spread;
+    for (int attempt = 0;; ++attempt) {
+      std::normal_distribution<double> scatter(0.0, spread);
+      const double yaw = uniform(rng, -kPi, kPi);
+      const Eigen::Vector2d half = turnedExtents(extents[i].x(), extents[i].y(), yaw) / 2;
+      const Eigen::Vector2d lo = o.area.centre - o.area.size / 2 + half;
+      const Eigen::Vector2d hi = o.area.centre + o.area.size / 2 - half;
+      const Eigen::Vector2d c = (o.heap_centre + Eigen::Vector2d(scatter(rng), scatter(rng))).cwiseMax(lo).cwiseMin(hi);
+      s.pose = Eigen::Vector3d(c.x(), c.y(), yaw);
+      double under = 0.0;
+      int depth = 1;
+      for (size_t j = 0; j < i; ++j) {
+        if (boxGap(sherds[j].pose, extents[j] / 2, s.pose, extents[i] / 2) < 0.0) {
+          under = std::max(under, top[j]);
+          depth = std::max(depth, layer[j] + 1);
+        }
+      }
+      if (depth <= o.heap_layers || attempt >= 200) {
+        s.drop_height = o.heap_drop_height + under;
+        top[i] = s.drop_height + height;
+        layer[i] = depth;
+        break;
+      }
+      if (attempt % 10 == 9) spread *= 1.2;
+    }
+  }
 }
 
 }  // namespace rascal_sim

@@ -127,6 +127,20 @@ Scenario ScenarioLoader::parse(const std::string& yaml_text) const {
     o.length_max = number(gen["length_max"], "generate.length_max", o.length_max, o.length_min, 0.10);
     o.width_min = number(gen["width_min"], "generate.width_min", o.width_min, 0.02, 0.10);
     o.width_max = number(gen["width_max"], "generate.width_max", o.width_max, o.width_min, 0.10);
+    if (const YAML::Node heap = gen["heap"]) {
+      // a bag tipped out: every generated sherd dropped around one spot (ScenarioGenerator)
+      if (!heap.IsMap()) fail("generate.heap", "expected {centre: [x, y], spread: m, drop_height: m, layers: n}");
+      o.heap = true;
+      o.heap_centre = o.area.centre;
+      if (heap["centre"]) {
+        const auto v = numbers(heap["centre"], "generate.heap.centre", 2);
+        o.heap_centre = {v[0], v[1]};
+        if (!o.area.contains(o.heap_centre)) fail("generate.heap.centre", "must lie on the station it is tipped onto");
+      }
+      o.heap_spread = number(heap["spread"], "generate.heap.spread", o.heap_spread, 0.0, 0.2);
+      o.heap_drop_height = number(heap["drop_height"], "generate.heap.drop_height", o.heap_drop_height, 0.0, 0.3);
+      o.heap_layers = static_cast<int>(number(heap["layers"], "generate.heap.layers", o.heap_layers, 1, 10));
+    }
     ScenarioGenerator g(munsell_);
     s.sherds = g.generate(o);
   }
