@@ -10,6 +10,7 @@
 #include "rascal_perception/GraspPlanner.hpp"
 #include "rascal_perception/SherdMeasurer.hpp"
 #include "rascal_perception/SherdSegmenter.hpp"
+#include "rascal_perception/StackSplitter.hpp"
 #include "rascal_perception/Types.hpp"
 
 namespace rascal_perception {
@@ -60,6 +61,7 @@ class SherdDetector {
   PerceptionConfig config_;
   std::map<std::string, Station> stations_;
   SherdSegmenter segmenter_;
+  StackSplitter stacks_;
   SherdMeasurer measurer_;
   GraspPlanner planner_;
   cv::Mat ray_z_;

@@ -37,7 +37,10 @@ GraspPlanner::GraspPlanner(const PerceptionConfig& config) : config_(config) {
 }
 
 void GraspPlanner::plan(SherdDetection& s) const {
-  const double tip = std::max(config_.grasp_height_fraction * s.height, config_.grasp_tip_clearance);
+  // from what the sherd rests on (the station, or the sherd under it in a heap: closing lower
+  // would take that one too)
+  const double own = std::max(s.height - s.support, 0.0);
+  const double tip = s.support + std::max(config_.grasp_height_fraction * own, config_.grasp_tip_clearance);
   s.grasp = Eigen::Isometry3d::Identity();
   s.grasp.linear() = (Eigen::AngleAxisd(s.yaw, Eigen::Vector3d::UnitZ()) *
                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY())).toRotationMatrix();

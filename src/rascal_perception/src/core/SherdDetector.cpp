@@ -204,15 +204,28 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
   const PlaneFit plane = depth_mm.empty() ? PlaneFit() : measurer_.fitPlane(depth_mm, usable_, view, surface_z);
   r.plane = plane.ok ? plane.plane : Eigen::Vector4d(0, 0, 1, -surface_z);
   r.plane_inliers = plane.inliers;
+  // sherds on sherds (a tipped-out bag): one blob, cut apart where the depth steps by a wall
+  const cv::Mat height =
+      depth_mm.empty() ? cv::Mat()
+                       : StackSplitter::heightMap(depth_mm, view, r.plane, config_.depth_min, config_.depth_max);
+  StackOptions stack;
+  const double ppm = pixelsPerMetre(view, surface_z);
+  stack.min_area_px = static_cast<int>(0.5 * std::pow(config_.min_sherd_size * ppm, 2));
   for (const Blob& b : blobs) {
-    SherdDetection d;
-    std::string why;
-    if (!measurer_.measure(b, rgb, depth_mm, view, r.plane, d, why)) {
-      ++r.rejected_size;
-      continue;
+    const std::vector<StackPart> parts = stacks_.split(b, height, stack);
+    r.splits += static_cast<int>(parts.size()) - 1;
+    for (const StackPart& part : parts) {
+      SherdDetection d;
+      std::string why;
+      if (!measurer_.measure(part.blob, rgb, depth_mm, view, r.plane, d, why)) {
+        ++r.rejected_size;
+        continue;
+      }
+      d.covered = part.covered;
+      d.support = part.support;
+      planner_.plan(d);
+      r.sherds.push_back(std::move(d));
     }
-    planner_.plan(d);
-    r.sherds.push_back(std::move(d));
   }
   planner_.score(r.sherds);
   // best score first, ties in segmentation order; which sherd is picked is the task layer's choice

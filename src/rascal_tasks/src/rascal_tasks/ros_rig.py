@@ -63,6 +63,7 @@ def observation_from_msg(s) -> rig.Observation:
         width=s.width,
         height=s.height,
         thickness=s.thickness,
+        covered=s.covered,
         vessel_diameter=s.vessel_diameter,
         vessel_diameter_sigma=s.vessel_diameter_sigma,
         grasp_x=s.grasp_pose.position.x,

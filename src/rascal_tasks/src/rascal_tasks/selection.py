@@ -7,16 +7,26 @@ from typing import List
 
 from rascal_tasks.rig import Observation
 
+# A sherd with more of its outline than this under another one lying on it is not picked while
+# a free one is left: lifting it would drag or lift the one on top (a tipped-out bag). Its
+# measurement is of the part that shows; it is picked from a later survey, once uncovered.
+COVERED = 0.05
+
+
+def covered(o: Observation) -> bool:
+    return o.covered > COVERED
+
 
 def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
-    """`found` in the order to pick it by `policy`:
+    """`found` in the order to pick it: sherds nothing lies on first (the top of a heap), the
+    least covered of the rest after them; within each, by `policy`:
     - nearest: nearest the arm's base first (the shortest reach, the least time; the default);
     - largest: largest length x width first;
     - most_isolated: largest edge-to-edge gap to its nearest neighbour first.
     Python's sort is stable: detection order breaks ties."""
     if policy == "largest":
-        return sorted(found, key=lambda o: -o.length * o.width)
-    if policy == "most_isolated":
+        ordered = sorted(found, key=lambda o: -o.length * o.width)
+    elif policy == "most_isolated":
 
         def gap(o):  # to the nearest neighbour, edge to edge along the line of centres
             return min(
@@ -24,5 +34,7 @@ def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
                 default=math.inf,
             )
 
-        return sorted(found, key=lambda o: -gap(o))
-    return sorted(found, key=lambda o: math.hypot(o.x, o.y))
+        ordered = sorted(found, key=lambda o: -gap(o))
+    else:
+        ordered = sorted(found, key=lambda o: math.hypot(o.x, o.y))
+    return sorted(ordered, key=lambda o: o.covered if covered(o) else 0.0)

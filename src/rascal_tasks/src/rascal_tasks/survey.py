@@ -9,7 +9,7 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.rig import Observation
-from rascal_tasks.selection import in_pick_order
+from rascal_tasks.selection import covered, in_pick_order
 
 # Wrist camera offset from ee_gripper_link when the gripper points down, along the gripper's
 # yaw direction (camera_link sits 0.055 m "above" gripper_link in the URDF).
@@ -90,7 +90,9 @@ class Survey(BatchState):
 
 
 class NextSherd(BatchState):
-    """After a sherd: take the next one already seen, or survey again."""
+    """After a sherd: take the next one already seen, or survey again. A covered sherd is never
+    taken from an old survey: what lay on it has been picked since, so it shows more of itself
+    now than was measured (and may have moved)."""
 
     def __init__(self, batch):
         super().__init__(batch, ["pickup", "survey"])
@@ -99,4 +101,7 @@ class NextSherd(BatchState):
         return "Next sherd"
 
     def run(self):
-        return "pickup" if self.batch.pending else "survey"
+        b = self.batch
+        if b.pending and covered(b.pending[0]):
+            b.pending = []
+        return "pickup" if b.pending else "survey"
