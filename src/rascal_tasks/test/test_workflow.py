@@ -15,7 +15,7 @@ from rascal_tasks.selection import in_pick_order
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.station_states import AtStation
 from rascal_tasks.config import config_from_dict
-from rascal_tasks.survey import lawnmower, merge
+from rascal_tasks.survey import NextSherd, lawnmower, merge
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
@@ -293,6 +293,28 @@ def test_the_selection_policies_order_the_merged_survey():
     assert in_pick_order(found, "largest") == [b, c, a]
     assert in_pick_order(found, "most_isolated")[0] is b
     assert in_pick_order([a], "most_isolated") == [a]
+
+
+def test_sherds_nothing_lies_on_are_picked_first_whatever_the_policy():
+    a = _obs(0.10, 0.20, 0.040, 0.030)  # nearest, largest ... but half under b
+    a.covered = 0.4
+    b = _obs(0.13, 0.21, 0.035, 0.030)  # lies on a
+    c = _obs(0.30, 0.30, 0.030, 0.025)
+    d = _obs(0.25, 0.30, 0.030, 0.025)
+    d.covered = 0.1  # less covered than a: next after the free ones
+    for policy in ("nearest", "largest", "most_isolated"):
+        order = in_pick_order([a, b, c, d], policy)
+        assert sorted(order[:2], key=id) == sorted([b, c], key=id) and order[2:] == [d, a], policy
+
+
+def test_a_covered_sherd_is_never_taken_from_an_old_survey(data):
+    batch = _batch(config_from_dict(data))
+    free, under = _obs(0.10, 0.20, 0.04, 0.03), _obs(0.12, 0.2, 0.04, 0.03)
+    under.covered = 0.3
+    batch.pending = [free, under]
+    assert NextSherd(batch).run() == "pickup"
+    batch.pending.pop(0)  # picked: what lay on `under` may have gone, it must be looked at again
+    assert NextSherd(batch).run() == "survey" and batch.pending == []
 
 
 def test_calibration_keeps_the_model_of_a_station_where_a_sherd_lies(data):
