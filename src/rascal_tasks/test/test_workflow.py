@@ -13,6 +13,7 @@ from rascal_tasks.recovery import Recover
 from rascal_tasks.resume import PUT_BACK_HEIGHT, Calibrate, Home, Resume
 from rascal_tasks.selection import in_pick_order
 from rascal_tasks.sherd_record import SherdRecord
+from rascal_tasks.singulation import PUSH, push_direction
 from rascal_tasks.station_states import AtStation
 from rascal_tasks.config import config_from_dict
 from rascal_tasks.survey import NextSherd, lawnmower, merge
@@ -389,3 +390,22 @@ def test_the_batch_keeps_why_it_stopped_and_whether_the_arm_was_parked(data):
     b.rig.arm = _StuckArm()
     assert workflow.Park(b).execute(None) == "aborted"
     assert b.park_failed and "no answer from /rascal/arm/move" in b.stop_reason
+
+
+def test_a_push_keeps_the_sherd_on_the_mat_and_moves_it_away_from_its_neighbours(data):
+    area = config_from_dict(data).stations["pickup"].area  # x 0.01..0.31, y 0.17..0.33
+    o = _obs(0.16, 0.25, 0.05, 0.04)
+    left = _obs(0.11, 0.25, 0.05, 0.04)  # neighbours left and right: push along y
+    right = _obs(0.21, 0.25, 0.05, 0.04)
+    dx, dy = push_direction(o, [o, left, right], area)
+    assert abs(dx) < 0.5 and abs(dy) > 0.85
+    # in a corner the only pushes left are inwards, and none may end off the mat
+    corner = _obs(0.045, 0.205, 0.05, 0.04)
+    dx, dy = push_direction(corner, [corner], area)
+    assert dx > 0 and dy > 0
+    end = (corner.x + PUSH * dx, corner.y + PUSH * dy)
+    assert area.has(end)
+    # a sherd as long as the mat is wide cannot be pushed anywhere along y
+    long = _obs(0.16, 0.25, 0.15, 0.04)
+    d = push_direction(long, [long], area)
+    assert d is None or abs(d[1]) < 1e-9

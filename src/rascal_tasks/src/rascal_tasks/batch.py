@@ -48,6 +48,7 @@ class Batch:
         self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
         self.misses = {}  # rounded (x, y) -> pickups that failed there
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
+        self.pushed = set()  # rounded (x, y) where a sherd was pushed apart (singulation.py)
         self.pending: List[Observation] = []
         self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
         self.empty_surveys = 0

@@ -5,6 +5,7 @@ gripper, numbered. No ROS in here.
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.sherd_record import SherdRecord
+from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction
 
 
 class Pickup(BatchState):
@@ -22,9 +23,11 @@ class Pickup(BatchState):
             b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
             return "held"
         attempts = b.config["recovery"]["max_grasp_attempts"]
-        b.pending = []  # the area changed under us: survey again
+        others, b.pending = b.pending, []  # the area changed under us: survey again
         key = (round(o.x, 2), round(o.y, 2))
         b.misses[key] = b.misses.get(key, 0) + 1
+        if b.misses[key] >= 2 and self.singulate(o, others, key):
+            return "missed"
         if b.misses[key] >= 2:
             b.unpickable.append((o.x, o.y))
             b.event(
@@ -34,6 +37,25 @@ class Pickup(BatchState):
                 "%d failed grasps" % (o.x, o.y, 2 * attempts),
             )
         return "missed"
+
+    def singulate(self, o, others, key) -> bool:
+        """Failed twice here: push it apart from its neighbours, once per spot (singulation.py),
+        if the batch has pushes left and a push keeps it on the mat. True when it was pushed."""
+        b = self.batch
+        if key in b.pushed or len(b.pushed) >= MAX_PUSHES:
+            return False
+        b.pushed.add(key)
+        d = push_direction(o, others, b.pickup.area)
+        if d is None or not push(b, o, d):
+            return False
+        b.event(
+            None,
+            "pushed",
+            "sherd at (%.3f, %.3f) m pushed %.0f mm towards (%.2f, %.2f) after %d failed "
+            "grasps, to part it from its neighbours"
+            % (o.x, o.y, PUSH * 1000, d[0], d[1], 2 * b.config["recovery"]["max_grasp_attempts"]),
+        )
+        return True
 
     def sherd_failed(self, failure):
         """Its grasp was refused: it has no number (it never left the mat), and another try

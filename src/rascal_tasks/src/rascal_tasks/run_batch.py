@@ -279,6 +279,7 @@ class Run:
             if done:  # what the batch before learnt about the mat
                 batch.unpickable = done[-1].unpickable
                 batch.misses = done[-1].misses
+                batch.pushed = done[-1].pushed
             progress.batch = batch
             self.batch, self.machine = batch, build_machine(batch)
             if self.stop.is_set():  # Ctrl-C while the machine was being built
