@@ -137,6 +137,22 @@ def test_a_steady_sherd_is_weighed_on_a_checked_tare(station):
     assert sherd.status == "weighed"
 
 
+@pytest.mark.parametrize("load, flagged", [(SHERD, False), (2.3 * SHERD, True)])
+def test_more_mass_than_one_sherd_of_its_size_can_have_is_flagged(station, load, flagged):
+    # 45 x 35 mm with a 6 mm wall: 13.9 g (1.47 g/cm^3 of its box) is one sherd; twice that
+    # and more is no single sherd of that size (at most 2.3 g/cm^3 over the box, 10 % curved)
+    plugin, sherd, scale, world, recorder, log = station
+    sherd.observation = rig.Observation(
+        0.1, 0.2, 0, 0.045, 0.035, 0.012, 0.1, 0.2, 0.01, 0, 0.05, thickness=0.006
+    )
+    plugin.before_place(sherd)
+    _place(world, scale, at_load=load)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).mass == pytest.approx(load, abs=5e-5)  # recorded as weighed, and ...
+    notes = [n for n in _row(recorder).notes if n.startswith("two sherds in one grasp?")]
+    assert bool(notes) is flagged, _row(recorder).notes
+
+
 def test_unstable_longer_than_every_reread_is_mass_unstable_with_no_mass(station, config):
     plugin, sherd, scale, world, recorder, log = station
     plugin.before_place(sherd)

@@ -306,6 +306,10 @@ def test_sherds_nothing_lies_on_are_picked_first_whatever_the_policy():
     for policy in ("nearest", "largest", "most_isolated"):
         order = in_pick_order([a, b, c, d], policy)
         assert sorted(order[:2], key=id) == sorted([b, c], key=id) and order[2:] == [d, a], policy
+    # of the free ones, one whose fingers would land on a neighbour goes after the others
+    b.grasp_clear = False
+    for policy in ("nearest", "largest", "most_isolated"):
+        assert in_pick_order([a, b, c, d], policy) == [c, b, d, a], policy
 
 
 def test_a_covered_sherd_is_never_taken_from_an_old_survey(data):

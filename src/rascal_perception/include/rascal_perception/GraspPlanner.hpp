@@ -7,26 +7,50 @@
 // i.e. the fingertips close at 60 % of the measured top height but never lower than 2.5 mm above
 // the station surface; opening = width + grasp_margin clamped to the gripper's opening limits
 // (the URDF's finger limits: 30 .. 74 mm on the wx250s).
+//
+// With the height map (GraspContext) the fingers' footprints are checked too: each finger, 20 mm
+// wide and 8 mm thick, beside the sherd at the opening, must close above what lies there (a
+// neighbour in a heap). The minor axis is tried first, then turned by 15, 30, 45 and 90 degrees
+// (the opening follows the outline's extent across each); the first clear one is taken, else the
+// clearest (grasp_clear false).
+#include <opencv2/core.hpp>
 #include <vector>
 
+#include "rascal_perception/SherdMeasurer.hpp"
 #include "rascal_perception/Types.hpp"
 
 namespace rascal_perception {
 
+/// What the planner may look at around a sherd: the height map above the table plane
+/// (StackSplitter::heightMap), the view it was taken from and the sherd's own pixels.
+struct GraspContext {
+  const cv::Mat* height = nullptr;
+  const CameraView* view = nullptr;
+  const Blob* own = nullptr;
+};
+
 class GraspPlanner {
  public:
   static constexpr double kFingerWidth = 0.020;  ///< [m] gap that lets a finger in (score saturates)
+  /// [m] a finger's thickness along the closing direction (the simulator's finger box; the
+  /// scenario generator keeps this and the grasp margin between sherds)
+  static constexpr double kFingerThickness = 0.008;
+  /// [m] a fingertip this far above what lies under its footprint (90th percentile) is clear
+  static constexpr double kFingerClearance = 0.0005;
 
   /// Throws std::invalid_argument when config.gripper has no finger limits (not read from a URDF).
   explicit GraspPlanner(const PerceptionConfig& config);
-  /// Fills grasp and grasp_width of one sherd.
-  void plan(SherdDetection& sherd) const;
+  /// Fills grasp and grasp_width of one sherd (and finger_clearance, grasp_clear with `context`).
+  void plan(SherdDetection& sherd, const GraspContext* context = nullptr) const;
   /// Fills clearance (gap to the nearest other outline) and score of every sherd.
   void score(std::vector<SherdDetection>& sherds) const;
   double minOpening() const { return config_.gripper.minOpening(); }  ///< [m]
   double maxOpening() const { return config_.gripper.maxOpening(); }  ///< [m]
 
  private:
+  /// [m] fingertip height above the plane minus what lies under the fingers' footprints.
+  double fingerClearance(double yaw, double opening, const Eigen::Vector2d& centre, double surface, double tip,
+                         const GraspContext& context) const;
   PerceptionConfig config_;
 };
 

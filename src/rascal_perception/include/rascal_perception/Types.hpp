@@ -71,6 +71,8 @@ struct SherdDetection {
   double clearance = 1.0;      ///< [m] gap to the nearest other sherd (1 = alone)
   double covered = 0.0;        ///< [1] share of its edge under another sherd lying on it (StackSplitter)
   double support = 0.0;        ///< [m] height above `surface` of what it rests on (0: the station)
+  double finger_clearance = 1.0;  ///< [m] fingertips above what lies beside it (GraspPlanner; 1: not checked)
+  bool grasp_clear = true;     ///< false: no grasp direction found whose fingers clear the neighbours
   bool depth_valid = false;    ///< false: measured without depth (height unknown = 0)
   float image_box[5] = {0, 0, 0, 0, 0};  ///< u, v, length, width [px], angle [rad]
   std::vector<Eigen::Vector3d> outline;  ///< [m] top-view outline, z = station surface

@@ -36,16 +36,79 @@ GraspPlanner::GraspPlanner(const PerceptionConfig& config) : config_(config) {
   }
 }
 
-void GraspPlanner::plan(SherdDetection& s) const {
+void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
   // from what the sherd rests on (the station, or the sherd under it in a heap: closing lower
   // would take that one too)
   const double own = std::max(s.height - s.support, 0.0);
   const double tip = s.support + std::max(config_.grasp_height_fraction * own, config_.grasp_tip_clearance);
+  double yaw = s.yaw;
+  Eigen::Vector2d centre = s.centre.head<2>();
+  double opening = std::clamp(s.width + config_.grasp_margin, minOpening(), maxOpening());
+  if (context && context->height && context->view && !context->height->empty() && s.outline.size() >= 3) {
+    double best = -std::numeric_limits<double>::infinity();
+    bool found = false;
+    for (const double turn_deg : {0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 90.0}) {
+      const double y = s.yaw + turn_deg * M_PI / 180.0;
+      const Eigen::Vector2d across(-std::sin(y), std::cos(y));  // the fingers close along R*y
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const Eigen::Vector3d& p : s.outline) {
+        const double t = across.dot(p.head<2>() - s.centre.head<2>());
+        lo = std::min(lo, t);
+        hi = std::max(hi, t);
+      }
+      const double need = hi - lo + config_.grasp_margin;
+      if (need > maxOpening()) continue;
+      const double open = std::clamp(need, minOpening(), maxOpening());
+      const Eigen::Vector2d c = s.centre.head<2>() + across * (lo + hi) / 2;
+      const double clear = fingerClearance(y, open, c, s.surface, tip, *context);
+      if (clear >= kFingerClearance) {
+        yaw = y, centre = c, opening = open, best = clear, found = true;
+        break;
+      }
+      if (clear > best) yaw = y, centre = c, opening = open, best = clear;
+    }
+    s.finger_clearance = std::isfinite(best) ? best : -1.0;
+    s.grasp_clear = found;
+  }
+  while (yaw > M_PI / 2) yaw -= M_PI;  // the two fingers are alike: yaw and yaw + pi are one grasp
+  while (yaw <= -M_PI / 2) yaw += M_PI;
   s.grasp = Eigen::Isometry3d::Identity();
-  s.grasp.linear() = (Eigen::AngleAxisd(s.yaw, Eigen::Vector3d::UnitZ()) *
+  s.grasp.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY())).toRotationMatrix();
-  s.grasp.translation() = Eigen::Vector3d(s.centre.x(), s.centre.y(), s.surface + tip + config_.gripper.fingertip_offset);
-  s.grasp_width = std::clamp(s.width + config_.grasp_margin, minOpening(), maxOpening());
+  s.grasp.translation() = Eigen::Vector3d(centre.x(), centre.y(), s.surface + tip + config_.gripper.fingertip_offset);
+  s.grasp_width = opening;
+}
+
+double GraspPlanner::fingerClearance(double yaw, double opening, const Eigen::Vector2d& centre, double surface,
+                                     double tip, const GraspContext& ctx) const {
+  const cv::Mat& height = *ctx.height;
+  const Eigen::Vector2d across(-std::sin(yaw), std::cos(yaw)), along(std::cos(yaw), std::sin(yaw));
+  const Eigen::Isometry3d camera_T_base = ctx.view->base_T_camera.inverse();
+  double worst = std::numeric_limits<double>::infinity();
+  for (const double side : {-1.0, 1.0}) {
+    std::vector<float> under;  // heights the finger's footprint looks down on
+    for (double t = 0.0; t <= kFingerThickness + 1e-9; t += 0.002) {
+      for (double u = -kFingerWidth / 2; u <= kFingerWidth / 2 + 1e-9; u += 0.002) {
+        const Eigen::Vector2d p = centre + across * side * (opening / 2 + t) + along * u;
+        const Eigen::Vector3d q = camera_T_base * Eigen::Vector3d(p.x(), p.y(), surface + tip);
+        if (q.z() <= 0.0) continue;
+        const Eigen::Vector2d uv = ctx.view->intrinsics.project(q);
+        const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
+        if (x < 0 || y < 0 || x >= height.cols || y >= height.rows) continue;
+        if (ctx.own && ctx.own->bounds.contains(cv::Point(x, y)) &&
+            ctx.own->mask.at<uint8_t>(y - ctx.own->bounds.y, x - ctx.own->bounds.x)) {
+          continue;  // the sherd itself (its top seen past its edge)
+        }
+        const float h = height.at<float>(y, x);
+        if (h == h) under.push_back(h);
+      }
+    }
+    if (under.empty()) continue;
+    const size_t k = under.size() * 9 / 10;  // a few noisy pixels do not block a finger
+    std::nth_element(under.begin(), under.begin() + k, under.end());
+    worst = std::min(worst, tip - under[k]);
+  }
+  return worst;
 }
 
 void GraspPlanner::score(std::vector<SherdDetection>& sherds) const {
@@ -61,7 +124,7 @@ void GraspPlanner::score(std::vector<SherdDetection>& sherds) const {
     const double isolation = std::clamp(gap / kFingerWidth, 0.0, 1.0);
     const double fit = s.width + config_.grasp_margin <= maxOpening() ? 1.0 : 0.3;
     const double depth = s.depth_valid ? 1.0 : 0.5;
-    s.score = fit * depth * (0.5 + 0.5 * isolation);
+    s.score = fit * depth * (0.5 + 0.5 * isolation) * (s.grasp_clear ? 1.0 : 0.5);
   }
 }
 

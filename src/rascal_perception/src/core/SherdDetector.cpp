@@ -223,7 +223,11 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
       }
       d.covered = part.covered;
       d.support = part.support;
-      planner_.plan(d);
+      GraspContext around;
+      around.height = &height;
+      around.view = &view;
+      around.own = &part.blob;
+      planner_.plan(d, &around);
       r.sherds.push_back(std::move(d));
     }
   }

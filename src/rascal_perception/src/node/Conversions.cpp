@@ -74,6 +74,7 @@ rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& head
   s.height = d.height;
   s.thickness = d.thickness;
   s.covered = d.covered;
+  s.grasp_clear = d.grasp_clear;
   s.vessel_diameter = d.diameter;
   s.vessel_diameter_sigma = d.diameter_sigma;
   s.area = d.area;

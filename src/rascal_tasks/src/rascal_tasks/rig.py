@@ -41,6 +41,7 @@ class Observation:
     vessel_diameter: float = 0.0  # the vessel's outer diameter from the curvature (0 = not told)
     vessel_diameter_sigma: float = 0.0  # its 1-sigma uncertainty
     covered: float = 0.0  # share of its outline under another sherd lying on it (a heap)
+    grasp_clear: bool = True  # perception found a grasp whose fingers clear its neighbours
 
     def distance_to(self, x: float, y: float) -> float:
         return math.hypot(self.x - x, self.y - y)

@@ -64,6 +64,7 @@ def observation_from_msg(s) -> rig.Observation:
         height=s.height,
         thickness=s.thickness,
         covered=s.covered,
+        grasp_clear=s.grasp_clear,
         vessel_diameter=s.vessel_diameter,
         vessel_diameter_sigma=s.vessel_diameter_sigma,
         grasp_x=s.grasp_pose.position.x,

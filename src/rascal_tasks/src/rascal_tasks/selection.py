@@ -19,7 +19,8 @@ def covered(o: Observation) -> bool:
 
 def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
     """`found` in the order to pick it: sherds nothing lies on first (the top of a heap), the
-    least covered of the rest after them; within each, by `policy`:
+    least covered of the rest after them; of alike covered ones, those whose fingers clear the
+    neighbours (perception's grasp_clear) first; then by `policy`:
     - nearest: nearest the arm's base first (the shortest reach, the least time; the default);
     - largest: largest length x width first;
     - most_isolated: largest edge-to-edge gap to its nearest neighbour first.
@@ -37,4 +38,4 @@ def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
         ordered = sorted(found, key=lambda o: -gap(o))
     else:
         ordered = sorted(found, key=lambda o: math.hypot(o.x, o.y))
-    return sorted(ordered, key=lambda o: o.covered if covered(o) else 0.0)
+    return sorted(ordered, key=lambda o: (o.covered if covered(o) else 0.0, not o.grasp_clear))

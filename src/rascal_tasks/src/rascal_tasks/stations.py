@@ -17,6 +17,12 @@ STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
 # (shared/facts/sherds_and_colour.md §2). A lighter steady reading means the sherd is not on the
 # scale; an unsteady one means nothing.
 MIN_SHERD_MASS = 0.001  # kg
+# The most one sherd of a measured size can weigh: its whole bounding box (an outline fills
+# 60-85 % of it) at the wall thickness, curved (up to ~10 % more surface), of the densest ware
+# (fired clay 1.5-2.3 g/cm^3, facts sherds_and_colour.md §2). More than that on the scale is
+# two sherds lifted as one (a heap): flagged, for a person to look.
+DENSEST_WARE = 2300.0  # kg/m^3
+CURVED_SURFACE = 1.1
 SCALE_POLL = 0.05  # s (rig clock) between looks at the scale's readings
 _STAMP_SLACK = 1e-3  # s: readings 10 Hz apart stamped a little early or late still cover
 
@@ -205,7 +211,23 @@ class ScaleStation(StationPlugin):
             )
             return "missing"
         sherd.record_mass(reading.mass)
+        self._check_one_sherd(sherd, reading.mass)
         return "done"
+
+    def _check_one_sherd(self, sherd, kg: float):
+        """Flags a mass no single sherd of the size the wrist camera measured can have."""
+        o = sherd.observation
+        if o is None or o.thickness <= 0.0:
+            return
+        most = o.length * o.width * o.thickness * CURVED_SURFACE * DENSEST_WARE
+        if kg > most:
+            text = (
+                "two sherds in one grasp? %.1f g is more than one sherd of %.0f x %.0f mm with "
+                "a %.1f mm wall can weigh (%.1f g at most)"
+                % (kg * 1000, o.length * 1000, o.width * 1000, o.thickness * 1000, most * 1000)
+            )
+            self.batch.event(sherd, "mass_too_high", text)
+            sherd.note(text)
 
     def _mass_unstable(self, sherd, reason: str):
         """No trustworthy mass: recorded so (no mass value), and the sherd goes on."""
