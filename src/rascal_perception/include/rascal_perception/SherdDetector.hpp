@@ -37,9 +37,13 @@ class SherdDetector {
   DetectionResult detect(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
                          const CameraView& view, double surface_z);
   /// Segmentation only: the blobs and the foreground mask (for benches and the annotated image).
+  /// `check` false: blobs of any size and at the border too (detect checks the parts after
+  /// cutting stacks apart).
   std::vector<Blob> segment(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
                             const CameraView& view, double surface_z, cv::Mat& foreground,
-                            SegmentationStats* stats = nullptr);
+                            SegmentationStats* stats = nullptr, bool check = true);
+  /// The segmentation's options for a view of a station surface (sizes in pixels there).
+  SegmentationOptions segmentationOptions(const CameraView& view, double surface_z) const;
   bool calibrated(const std::string& station) const { return stations_.count(station) > 0; }
   const BackgroundModel* model(const std::string& station) const;
   const PerceptionConfig& config() const { return config_; }

@@ -15,6 +15,10 @@ struct SegmentationOptions {
   int border_margin = 3;         ///< [px]
   double split_min_neck = 0.75;  ///< see PerceptionConfig
   bool split = true;
+  /// false: blobs are returned whatever their size and however near the border, for the caller
+  /// to cut apart first (StackSplitter: a heap is one blob larger than any sherd, often cut by
+  /// the image border, with whole sherds in it) and to check each part with `accept`.
+  bool check = true;
 };
 
 struct SegmentationStats {
@@ -32,6 +36,9 @@ class SherdSegmenter {
   /// Blobs of a binary mask (no colour model): contours, border and size checks, splitting.
   std::vector<Blob> blobs(const cv::Mat& mask, const SegmentationOptions& options,
                           SegmentationStats* stats = nullptr) const;
+  /// The border and size checks of one blob (counted in `stats` when it fails one).
+  static bool accept(const Blob& blob, const cv::Size& image, const SegmentationOptions& options,
+                     SegmentationStats& stats);
   /// Splits one filled blob mask at its necks; returns 1 mask if it is one sherd.
   std::vector<cv::Mat> split(const cv::Mat& mask, double min_neck, double min_peak_px) const;
   /// The largest outer contour of `part` (CV_8U) as a blob; `offset` = image position of part(0, 0).

@@ -159,21 +159,27 @@ void SherdDetector::warpPriors(const Station& s, const CameraView& view, double 
                       cv::Scalar(0));
 }
 
-std::vector<Blob> SherdDetector::segment(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
-                                         const CameraView& view, double surface_z, cv::Mat& foreground,
-                                         SegmentationStats* stats) {
-  auto it = stations_.find(station);
-  if (it == stations_.end()) {
-    throw std::logic_error("SherdDetector::segment: station " + station + " has no background model");
-  }
-  const Station& s = it->second;
-  warpPriors(s, view, surface_z, allowed_, fixture_);
+SegmentationOptions SherdDetector::segmentationOptions(const CameraView& view, double surface_z) const {
   const double ppm = pixelsPerMetre(view, surface_z);
   SegmentationOptions o;
   o.min_side_px = 0.7 * config_.min_sherd_size * ppm;
   o.max_side_px = 1.5 * config_.max_sherd_size * ppm;
   o.border_margin = config_.border_margin;
   o.split_min_neck = config_.split_min_neck;
+  return o;
+}
+
+std::vector<Blob> SherdDetector::segment(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
+                                         const CameraView& view, double surface_z, cv::Mat& foreground,
+                                         SegmentationStats* stats, bool check) {
+  auto it = stations_.find(station);
+  if (it == stations_.end()) {
+    throw std::logic_error("SherdDetector::segment: station " + station + " has no background model");
+  }
+  const Station& s = it->second;
+  warpPriors(s, view, surface_z, allowed_, fixture_);
+  SegmentationOptions o = segmentationOptions(view, surface_z);
+  o.check = check;
   return segmenter_.segment(rgb, s.model, allowed_, fixture_, raised(depth_mm, view, surface_z), o, foreground,
                             stats);
 }
@@ -195,9 +201,10 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
   }
   cv::Mat foreground;
   SegmentationStats stats;
-  const std::vector<Blob> blobs = segment(station, rgb, depth_mm, view, surface_z, foreground, &stats);
-  r.rejected_border = stats.rejected_border;
-  r.rejected_size = stats.rejected_size;
+  // with depth, a blob too big or cut by the border may be a heap with whole sherds in it: it is
+  // cut apart first (below) and each part checked
+  const std::vector<Blob> blobs = segment(station, rgb, depth_mm, view, surface_z, foreground, &stats, depth_mm.empty());
+  const SegmentationOptions checks = segmentationOptions(view, surface_z);
   r.splits = stats.splits;
   cv::bitwise_not(foreground, usable_);
   if (!fixture_.empty()) usable_.setTo(0, fixture_);
@@ -215,6 +222,7 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
     const std::vector<StackPart> parts = stacks_.split(b, height, stack);
     r.splits += static_cast<int>(parts.size()) - 1;
     for (const StackPart& part : parts) {
+      if (!depth_mm.empty() && !SherdSegmenter::accept(part.blob, rgb.size(), checks, stats)) continue;
       SherdDetection d;
       std::string why;
       if (!measurer_.measure(part.blob, rgb, depth_mm, view, r.plane, d, why)) {
@@ -231,6 +239,8 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
       r.sherds.push_back(std::move(d));
     }
   }
+  r.rejected_border = stats.rejected_border;
+  r.rejected_size += stats.rejected_size;
   planner_.score(r.sherds);
   // best score first, ties in segmentation order; which sherd is picked is the task layer's choice
   std::stable_sort(r.sherds.begin(), r.sherds.end(),

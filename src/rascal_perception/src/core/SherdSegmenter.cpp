@@ -62,7 +62,7 @@ std::vector<Blob> SherdSegmenter::blobs(const cv::Mat& mask, const SegmentationO
   for (const auto& c : contours) {
     if (cv::contourArea(c) < noise_area) continue;
     const cv::Rect r = cv::boundingRect(c);
-    if (r.x < m || r.y < m || r.x + r.width > mask.cols - m || r.y + r.height > mask.rows - m) {
+    if (options.check && (r.x < m || r.y < m || r.x + r.width > mask.cols - m || r.y + r.height > mask.rows - m)) {
       ++st.rejected_border;
       continue;
     }
@@ -85,16 +85,28 @@ std::vector<Blob> SherdSegmenter::blobs(const cv::Mat& mask, const SegmentationO
     }
     for (Blob& b : found) {
       if (b.contour.empty()) continue;
-      const double lo = std::min(b.box.size.width, b.box.size.height);
-      const double hi = std::max(b.box.size.width, b.box.size.height);
-      if (lo < options.min_side_px || hi > options.max_side_px) {
-        ++st.rejected_size;
-        continue;
-      }
+      if (options.check && !accept(b, mask.size(), options, st)) continue;
       out.push_back(std::move(b));
     }
   }
   return out;
+}
+
+bool SherdSegmenter::accept(const Blob& b, const cv::Size& image, const SegmentationOptions& options,
+                            SegmentationStats& st) {
+  const int m = options.border_margin;
+  const cv::Rect& r = b.bounds;
+  if (r.x < m || r.y < m || r.x + r.width > image.width - m || r.y + r.height > image.height - m) {
+    ++st.rejected_border;
+    return false;
+  }
+  const double lo = std::min(b.box.size.width, b.box.size.height);
+  const double hi = std::max(b.box.size.width, b.box.size.height);
+  if (lo < options.min_side_px || hi > options.max_side_px) {
+    ++st.rejected_size;
+    return false;
+  }
+  return true;
 }
 
 std::vector<cv::Mat> SherdSegmenter::split(const cv::Mat& mask, double min_neck, double min_peak_px) const {
