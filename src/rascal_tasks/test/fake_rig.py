@@ -18,6 +18,7 @@ from rascal_tasks.sorting import SherdValues, choose_bin
 from rascal_tasks.survey import CAMERA_OFFSET
 
 VIEW_RADIUS = 0.15  # m around the wrist camera's axis
+DOUBLE_APART = 0.05  # m between two sherds set down together on the pickup mat
 GRASP_ABOVE = 0.005  # grasp_z above the station surface that perception plans
 
 
@@ -48,6 +49,10 @@ class World:
         self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
         self.camera_refusals = 0  # captures to refuse before one succeeds
         self.tare = 0.0
+        # sherd name -> the sherd lying under it that its first grasp lifts too (a heap); set
+        # down together, the second lands `DOUBLE_APART` from the first
+        self.doubles: Dict[str, str] = {}
+        self.held_extra: Optional[Sherd] = None
 
     def station_at(self, x, y):
         for st in self.config.stations.values():
@@ -56,7 +61,11 @@ class World:
         return None
 
     def lying(self, station: str) -> List[Sherd]:
-        return [s for s in self.sherds if s is not self.held and s.station == station]
+        return [
+            s
+            for s in self.sherds
+            if s is not self.held and s is not self.held_extra and s.station == station
+        ]
 
     def put(self, s: Sherd, x, y):
         st = self.station_at(x, y)
@@ -97,7 +106,15 @@ class _Gripper(rig.Gripper):
     def open(self, width=None):
         if self.w.held is not None:
             s, self.w.held = self.w.held, None
-            self.w.put(s, *self.w.at[:2])
+            x, y = self.w.at[:2]
+            self.w.put(s, x, y)
+            if self.w.held_extra is not None:
+                extra, self.w.held_extra = self.w.held_extra, None
+                # on the mat they fall apart (towards its middle); elsewhere they stay together
+                st = self.w.station_at(x, y)
+                if st is not None and st.type == "pickup":
+                    y += DOUBLE_APART if y <= st.area.center[1] else -DOUBLE_APART
+                self.w.put(extra, x, y)
         return 0.5
 
     def close(self):
@@ -106,6 +123,9 @@ class _Gripper(rig.Gripper):
         for s in self.w.lying(st.name if st else None):
             if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.height:
                 self.w.held, self.w.grasped_at = s, (x, y)
+                partner = self.w.doubles.pop(s.name, None)
+                if partner is not None:
+                    self.w.held_extra = next(p for p in self.w.sherds if p.name == partner)
                 return rig.GraspResult(True, s.width)
         return rig.GraspResult(False, 0.030)
 

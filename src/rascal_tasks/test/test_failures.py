@@ -189,3 +189,21 @@ def test_a_database_error_parks_and_stops(config):
     outcome, batch, rec = _run(config, world, Failing())
     assert outcome == "aborted" and world.named == ["sleep"]
     assert rec.status() == {1: "picked"}
+
+
+def test_two_sherds_lifted_as_one_are_put_back_apart_and_recorded_a_row_each(config):
+    # a's first grasp takes b (lying under it) too: the scale weighs 40 g, more than one
+    # 50 x 40 mm sherd with a 7 mm wall can weigh; both go back to the mat, apart, and each is
+    # recorded on its own, the first under the number the pair had
+    world = World(
+        config,
+        [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.29), Sherd("c", 0.20, 0.21, mass=0.015)],
+    )
+    world.doubles = {"a": "b"}
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished"
+    assert recorder.status() == {1: "done", 2: "done", 3: "done"}
+    masses = sorted(round(r.mass, 4) for r in recorder.sherds.values())
+    assert masses == [0.015, 0.02, 0.02]  # never 40 g in one row
+    assert any("put back apart" in n for r in recorder.sherds.values() for n in r.notes)
+    assert all(s.station == "discard" for s in world.sherds)

@@ -51,6 +51,11 @@ class Batch:
         self.pushed = set()  # rounded (x, y) where a sherd was pushed apart (singulation.py)
         self.pending: List[Observation] = []
         self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
+        self.put_back_doubles = {}  # seq -> times its grasp was put back as two sherds in one
+        self.renumber: Optional[SherdRecord] = (
+            None  # put back as two: its number goes to the next pick
+        )
+        self.seen: List[Observation] = []  # the last survey of the pickup area, merged
         self.empty_surveys = 0
         self.stop_reason: Optional[str] = None  # detail of the last STOPPING_EVENTS event
         self.park_failed = False  # workflow.Park could not park the arm

@@ -20,7 +20,14 @@ class Pickup(BatchState):
         b = self.batch
         o, tries, held = grasp_retrying(b, b.pending.pop(0), b.pickup)
         if held:
-            b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
+            if b.renumber is not None:  # two were put back: this one takes over that number
+                rec, b.renumber = b.renumber, None
+                rec.seen(o, b.pickup)
+                rec.picked_xy = (o.x, o.y)
+                rec.record_dimensions(o)
+                b.sherd = rec
+            else:
+                b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
             return "held"
         attempts = b.config["recovery"]["max_grasp_attempts"]
         others, b.pending = b.pending, []  # the area changed under us: survey again

@@ -1,11 +1,13 @@
 """A held sherd's way through the stations: TRANSLATE_i carries it, PLACE_i sets it down,
-STATION_i runs the station's plug-in (`stations.py`), REPICK_i picks it up again. No ROS here.
+STATION_i runs the station's plug-in (`stations.py`), REPICK_i picks it up again; PUT_BACK_i
+takes two sherds lifted as one back to the pickup mat, apart. No ROS here.
 """
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
 from rascal_tasks.manipulation import grasp, opening_for
 from rascal_tasks.rig import Observation
+from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
 
 
@@ -62,12 +64,13 @@ class Place(BatchState):
 
 class AtStation(BatchState):
     """Runs the station plug-in (weigh, photograph, discard); after the last station the sherd
-    is done. A plug-in's 'failed' is this sherd's failure (failures.py)."""
+    is done. A plug-in's 'failed' is this sherd's failure (failures.py); 'double' (the scale
+    weighed two sherds) goes to PUT_BACK."""
 
     next_sherd = "lost"
 
     def __init__(self, batch, index):
-        super().__init__(batch, ["done", "dropped", "lost"])
+        super().__init__(batch, ["done", "dropped", "lost", "double"])
         self.index = index
 
     def label(self):
@@ -88,6 +91,8 @@ class AtStation(BatchState):
             return "dropped"
         if outcome == "failed":
             raise SherdFailure("the %s station failed for it" % plugin.station.name, plugin.station)
+        if outcome == "double":
+            return "double"
         if outcome != "done":
             self.report("station_failed", "%s: unknown outcome %r" % (plugin.station.name, outcome))
             return "aborted"
@@ -138,3 +143,75 @@ class Repick(BatchState):
             s.grasped_as(o, st)
         s.lose("could not pick it up again at %s" % st.name)
         return "lost"
+
+
+class PutBack(BatchState):
+    """Two sherds were lifted as one (the scale weighed more than one sherd of the size seen can
+    weigh): both are picked up again and set down low over the freest spot of the pickup mat,
+    where they fall apart, and the area is surveyed again. The row keeps its number, with no
+    mass: the next sherd picked takes it over (its dimensions recorded afresh), so there is no
+    gap and no row of two."""
+
+    next_sherd = "lost"
+
+    def __init__(self, batch, index):
+        super().__init__(batch, ["surveyed", "lost"])
+        self.index = index
+
+    def label(self):
+        return "Put back from %s" % self.batch.station_names[self.index]
+
+    def run(self):
+        b = self.batch
+        s = b.sherd
+        st = b.config.stations[b.station_names[self.index]]
+        if Repick(b, self.index).run() != "held":
+            return "lost"  # Repick recorded it lost (the two lie at the station, for a person)
+        spots = [free_spot(b.pickup.area, b.seen)]
+        self._set_down(*spots[0])
+        plugin = b.plugins[self.index]
+        if isinstance(plugin, ScaleStation) and plugin.holds_something():
+            # the grasp took one of the two: the other is fetched too, and set down apart
+            seen = survey_at(b, st, *st.place_at)
+            if not seen or not grasp(b, seen[0], st):
+                raise SherdFailure(
+                    "the second of two sherds lifted as one stays on the %s" % st.name, st
+                )
+            here = Observation(*spots[0], 0.0, 0.1, 0.1, 0.0, *spots[0], 0.0, 0.0, 0.0)
+            spots.append(free_spot(b.pickup.area, b.seen + [here]))
+            self._set_down(*spots[1])
+        text = (
+            "two sherds in one grasp: put back apart at %s; this number goes to the next "
+            "sherd picked" % ", ".join("(%.3f, %.3f) m" % p for p in spots)
+        )
+        b.event(s, "put_back", text)
+        s.note(text)
+        b.renumber, b.sherd, b.pending = s, None, []
+        return "surveyed"
+
+    def _set_down(self, x, y):
+        """Carry what is in the fingers to (x, y) of the pickup mat and let it go just above."""
+        b = self.batch
+        s = b.sherd
+        b.move_down(x, y, b.travel_z(), s.grasp_yaw)
+        low = b.pickup.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
+        b.move_down(x, y, low, s.grasp_yaw, linear=True)
+        with b.phase("grasping"):
+            b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
+        b.move_down(x, y, b.travel_z(), s.grasp_yaw, linear=True)
+
+
+def free_spot(area, seen, step=0.01, inset=0.035):
+    """The point of `area` (config.Rect; `inset` from its edges: half a large sherd) farthest
+    from the outlines of the sherds `seen` there (their centres less half their length)."""
+    (cx, cy), (sx, sy) = area.center, area.size
+    best, room = (cx, cy), -1.0
+    nx, ny = max(1, int((sx - 2 * inset) / step)), max(1, int((sy - 2 * inset) / step))
+    for i in range(nx + 1):
+        for j in range(ny + 1):
+            x = cx - sx / 2 + inset + i * (sx - 2 * inset) / nx
+            y = cy - sy / 2 + inset + j * (sy - 2 * inset) / ny
+            r = min((o.distance_to(x, y) - o.length / 2 for o in seen), default=1.0)
+            if r > room:
+                best, room = (x, y), r
+    return best

@@ -65,11 +65,12 @@ class StationPlugin:
     def after_place(self, sherd) -> str:
         """Called with the sherd placed and the gripper back at travel height; records what it
         measured through `sherd` (SherdRecord). Returns 'done'; 'missing' when the sherd is
-        evidently not there (it is searched for like a drop); or 'failed' when the station could
-        not do its job for this sherd. A failed sherd that lies where the next sherd is placed
-        stops the batch with the arm parked, unfinished, for a person to look (a restart
-        resumes it); elsewhere (the discard box) it is recorded lost and the batch goes on
-        (`failures.classify`). A RigError raised here stops the batch."""
+        evidently not there (it is searched for like a drop); 'double' when it is two sherds
+        lifted as one (they are put back apart, station_states.PutBack); or 'failed' when the
+        station could not do its job for this sherd. A failed sherd that lies where the next
+        sherd is placed stops the batch with the arm parked, unfinished, for a person to look
+        (a restart resumes it); elsewhere (the discard box) it is recorded lost and the batch
+        goes on (`failures.classify`). A RigError raised here stops the batch."""
         raise NotImplementedError
 
 
@@ -137,6 +138,11 @@ class ScaleStation(StationPlugin):
                 "running?" % cfg["stable_timeout"],
             )
         return None, last
+
+    def holds_something(self) -> bool:
+        """Whether the pan (tared empty before the sherd) settles at a sherd's mass or more."""
+        reading, _ = self._settle(self.batch.rig.clock.now())
+        return reading is not None and reading.mass >= MIN_SHERD_MASS
 
     def _unsteady(self, last) -> str:
         cfg = self._cfg()
@@ -210,24 +216,34 @@ class ScaleStation(StationPlugin):
                 sherd, "scale_empty", "reads %.1f g, steady, after placing" % (reading.mass * 1000)
             )
             return "missing"
+        too_heavy = self._more_than_one_sherd(sherd, reading.mass)
+        if too_heavy and b.put_back_doubles.get(sherd.seq, 0) == 0:
+            # two sherds lifted as one (a heap): no mass for this row; they are put back apart
+            # (station_states.PutBack) and the sherd keeps its number for the next pick
+            b.put_back_doubles[sherd.seq] = 1
+            b.event(sherd, "two_in_one", too_heavy)
+            return "double"
         sherd.record_mass(reading.mass)
-        self._check_one_sherd(sherd, reading.mass)
+        if too_heavy:  # put back once already and as heavy again: one heavy sherd, flagged
+            b.event(sherd, "mass_too_high", too_heavy)
+            sherd.note("mass checked: %s; put back once and weighed alike again" % too_heavy)
         return "done"
 
-    def _check_one_sherd(self, sherd, kg: float):
-        """Flags a mass no single sherd of the size the wrist camera measured can have."""
+    @staticmethod
+    def _more_than_one_sherd(sherd, kg: float) -> str:
+        """Why `kg` is more than one sherd of the size the wrist camera measured can weigh, or
+        "" (also when its wall was not measured)."""
         o = sherd.observation
         if o is None or o.thickness <= 0.0:
-            return
+            return ""
         most = o.length * o.width * o.thickness * CURVED_SURFACE * DENSEST_WARE
-        if kg > most:
-            text = (
-                "two sherds in one grasp? %.1f g is more than one sherd of %.0f x %.0f mm with "
-                "a %.1f mm wall can weigh (%.1f g at most)"
-                % (kg * 1000, o.length * 1000, o.width * 1000, o.thickness * 1000, most * 1000)
-            )
-            self.batch.event(sherd, "mass_too_high", text)
-            sherd.note(text)
+        if kg <= most:
+            return ""
+        return (
+            "two sherds in one grasp? %.1f g is more than one sherd of %.0f x %.0f mm with a "
+            "%.1f mm wall can weigh (%.1f g at most)"
+            % (kg * 1000, o.length * 1000, o.width * 1000, o.thickness * 1000, most * 1000)
+        )
 
     def _mass_unstable(self, sherd, reason: str):
         """No trustworthy mass: recorded so (no mass value), and the sherd goes on."""

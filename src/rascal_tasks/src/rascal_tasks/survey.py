@@ -79,9 +79,13 @@ class Survey(BatchState):
     def run(self):
         b = self.batch
         found = survey_pickup_area(b)
+        b.seen = list(found)
         if not found:
             b.empty_surveys += 1
             if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
+                if b.renumber is not None:  # its number must not stay unfinished
+                    b.sherd, b.renumber = b.renumber, None
+                    b.sherd.lose("put back on the pickup mat as two sherds and not seen again")
                 return "empty"
             return self.run()
         b.empty_surveys = 0

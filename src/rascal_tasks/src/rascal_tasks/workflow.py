@@ -27,7 +27,7 @@ from rascal_tasks.pickup import Pickup
 from rascal_tasks.recovery import Recover
 from rascal_tasks.resume import Calibrate, Home, Resume
 from rascal_tasks.rig import RigError
-from rascal_tasks.station_states import AtStation, Place, Repick, Translate
+from rascal_tasks.station_states import AtStation, Place, PutBack, Repick, Translate
 from rascal_tasks.survey import NextSherd, Survey
 
 __all__ = ["Batch", "Park", "build_machine", "park", "smach"]
@@ -86,7 +86,9 @@ def build_machine(batch: Batch):
                 done="SURVEY_NEXT" if last else "REPICK_%d" % i,
                 dropped="RECOVER_%d" % i,
                 lost="SURVEY_NEXT",
+                double="PUT_BACK_%d" % i,
             )
+            add("PUT_BACK_%d" % i, PutBack(batch, i), surveyed="SURVEY", lost="SURVEY_NEXT")
             if not last:
                 add(
                     "REPICK_%d" % i,
