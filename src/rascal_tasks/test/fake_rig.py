@@ -239,6 +239,7 @@ class Recorder:
     """The catalogue's rows and status rules, in memory; `writes` lists every call in order."""
 
     AFTER = {
+        "picked": ("picked",),  # taken over by the next pick (two put back apart)
         "weighed": ("picked", "mass_unstable", "weighed"),
         "mass_unstable": ("picked", "mass_unstable"),
         "photographed": ("mass_unstable", "weighed", "photographed"),
@@ -308,6 +309,10 @@ class Recorder:
 
     def drop(self, seq, station):
         self.sherds[seq].drops += 1
+
+    def taken_over(self, seq, pickup_xy):
+        row = self._move(seq, "picked")
+        row.pickup_xy = tuple(pickup_xy)
 
     def grasp_attempt(self, seq, station):
         pass

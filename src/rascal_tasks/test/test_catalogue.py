@@ -573,3 +573,28 @@ def test_database_keeps_mass_or_reason_even_when_python_is_bypassed(catalogue, u
         with conn, conn.cursor() as cur:
             cur.execute("UPDATE sherds SET " + update + " WHERE sherd_id = %s", (s,))  # constants
     assert catalogue.get(s)["status"] == "picked"
+
+
+def test_a_number_taken_over_moves_its_pickup_spot_only_while_picked(catalogue):
+    catalogue.open_context("TR1-1023", "site")
+    s = catalogue.new_sherd("TR1-1023", pickup_xy=(0.10, 0.22))
+    catalogue.record_taken_over(s["sherd_id"], (0.18, 0.27))
+    row = catalogue.get(s["sherd_id"])
+    assert (row["pickup_x_m"], row["pickup_y_m"]) == (0.18, 0.27) and row["status"] == "picked"
+    assert "taken_over" in [e["kind"] for e in catalogue.events("TR1-1023")]
+    catalogue.record_mass(s["sherd_id"], 20.0)
+    with pytest.raises(StatusError, match="cannot record 'taken_over'"):
+        catalogue.record_taken_over(s["sherd_id"], (0.2, 0.2))
+    with pytest.raises(FieldError, match="pickup_x_m"):
+        catalogue.record_taken_over(s["sherd_id"], ("a", 0.2))
+
+
+def test_a_sherd_records_the_bin_it_went_into_with_the_reason(catalogue):
+    catalogue.open_context("TR1-1023", "site")
+    s = catalogue.new_sherd("TR1-1023", pickup_xy=(0.10, 0.22))
+    catalogue.record_bin(s["sherd_id"], "small_finds", "small_finds: length < 30 mm (24 mm)")
+    assert catalogue.get(s["sherd_id"])["bin"] == "small_finds"
+    ev = [e for e in catalogue.events("TR1-1023") if e["kind"] == "sorted"]
+    assert ev and "24 mm" in json.dumps(ev[-1], default=str)
+    with pytest.raises(FieldError, match="bin"):
+        catalogue.record_bin(s["sherd_id"], "no such; bin")

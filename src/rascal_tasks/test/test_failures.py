@@ -206,4 +206,5 @@ def test_two_sherds_lifted_as_one_are_put_back_apart_and_recorded_a_row_each(con
     masses = sorted(round(r.mass, 4) for r in recorder.sherds.values())
     assert masses == [0.015, 0.02, 0.02]  # never 40 g in one row
     assert any("put back apart" in n for r in recorder.sherds.values() for n in r.notes)
+    assert recorder.sherds[1].pickup_xy != (0.10, 0.22)  # where its new sherd was picked
     assert all(s.station == "discard" for s in world.sherds)

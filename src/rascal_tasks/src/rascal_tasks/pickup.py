@@ -21,11 +21,8 @@ class Pickup(BatchState):
         o, tries, held = grasp_retrying(b, b.pending.pop(0), b.pickup)
         if held:
             if b.renumber is not None:  # two were put back: this one takes over that number
-                rec, b.renumber = b.renumber, None
-                rec.seen(o, b.pickup)
-                rec.picked_xy = (o.x, o.y)
-                rec.record_dimensions(o)
-                b.sherd = rec
+                b.sherd, b.renumber = b.renumber, None
+                b.sherd.taken_over(o, b.pickup)
             else:
                 b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
             return "held"

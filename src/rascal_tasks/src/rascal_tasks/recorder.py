@@ -314,6 +314,10 @@ class Recorder:
     def drop(self, seq, station: str):
         self.catalogue.record_drop(self._id(seq), station)
 
+    def taken_over(self, seq, pickup_xy):
+        """Sherd `seq` (two put back apart) is now the sherd picked at `pickup_xy` [m]."""
+        self.catalogue.record_taken_over(self._id(seq), list(pickup_xy))
+
     def grasp_attempt(self, seq, station: str):
         self.catalogue.record_grasp_attempt(self._id(seq), station)
 

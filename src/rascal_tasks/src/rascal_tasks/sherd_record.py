@@ -43,6 +43,14 @@ class SherdRecord:
         rec.record_dimensions(o)
         return rec
 
+    def taken_over(self, o: Observation, station):
+        """Its number goes to the sherd just picked as `o` (this one was two sherds, put back
+        apart: station_states.PutBack); where it was picked and its size are recorded afresh."""
+        self.seen(o, station)
+        self.picked_xy = (o.x, o.y)
+        self.batch.recorder.taken_over(self.seq, (o.x, o.y))
+        self.record_dimensions(o)
+
     @classmethod
     def resumed(cls, batch, seq: int, status: str) -> "SherdRecord":
         """A sherd a killed run left unfinished; where it is, is not known yet."""

@@ -860,6 +860,20 @@ class Catalogue:
             sherd_id, "drop", UNFINISHED, {}, None, {"station": station}, increments=("drops",)
         )
 
+    def record_taken_over(self, sherd_id, pickup_xy):
+        """The number of two sherds put back apart goes to the sherd picked next, at
+        `pickup_xy` [m] (its dimensions follow); only while it is still 'picked'."""
+        x = check_number("pickup_x_m", pickup_xy[0], -10.0, 10.0, "m", allow_none=False)
+        y = check_number("pickup_y_m", pickup_xy[1], -10.0, 10.0, "m", allow_none=False)
+        return self._advance(
+            sherd_id,
+            "taken_over",
+            ("picked",),
+            {"pickup_x_m": x, "pickup_y_m": y},
+            None,
+            {"pickup_x_m": x, "pickup_y_m": y},
+        )
+
     def record_grasp_attempt(self, sherd_id, station=None):
         """One more grasp was tried (counted; no state change)."""
         check_text("station", station, 64)
