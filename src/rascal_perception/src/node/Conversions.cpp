@@ -105,17 +105,21 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
     box.type = visualization_msgs::Marker::CUBE;
     box.action = visualization_msgs::Marker::ADD;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    const double h = std::max(d.height, 0.002);
-    pose.translation() = Eigen::Vector3d(d.centre.x(), d.centre.y(), d.surface + 0.5 * h);
+    // from what it rests on (the table, or the sherd under it in a heap) to its top
+    const double h = std::max(d.height - d.support, 0.002);
+    pose.translation() = Eigen::Vector3d(d.centre.x(), d.centre.y(), d.surface + d.support + 0.5 * h);
     pose.linear() = Eigen::AngleAxisd(d.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     box.pose = tf2::toMsg(pose);
     box.scale.x = d.length;
     box.scale.y = d.width;
     box.scale.z = h;
-    box.color.r = i == 0 ? 1.0f : 0.2f;
-    box.color.g = i == 0 ? 0.3f : 0.9f;
-    box.color.b = 0.2f;
-    box.color.a = 0.5f;
+    // red: the best scored; green: free to pick; orange: the fingers would land on a
+    // neighbour; grey: lies under another sherd (picked later)
+    const bool under = d.covered > 0.05;
+    box.color.r = under ? 0.6f : (i == 0 || !d.grasp_clear) ? 1.0f : 0.2f;
+    box.color.g = under ? 0.6f : i == 0 ? 0.3f : d.grasp_clear ? 0.9f : 0.6f;
+    box.color.b = under ? 0.6f : 0.2f;
+    box.color.a = under ? 0.3f : 0.5f;
     a.markers.push_back(box);
 
     visualization_msgs::Marker arrow = box;
@@ -155,9 +159,9 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
     text.pose.orientation.w = 1.0;
     text.scale.z = 0.012;
     text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
-    char buf[96];
-    std::snprintf(buf, sizeof(buf), "#%zu %.0fx%.0f mm, wall %.1f mm", i, d.length * 1e3, d.width * 1e3,
-                  d.thickness * 1e3);
+    char buf[128];
+    std::snprintf(buf, sizeof(buf), "#%zu %.0fx%.0f mm, wall %.1f mm%s%s", i, d.length * 1e3, d.width * 1e3,
+                  d.thickness * 1e3, under ? ", under another" : "", d.grasp_clear ? "" : ", fingers blocked");
     text.text = buf;
     a.markers.push_back(text);
   }
