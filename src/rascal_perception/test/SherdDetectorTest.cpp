@@ -18,9 +18,6 @@
 #include "rascal_perception/SherdDetector.hpp"
 #include "rascal_perception/ShellFit.hpp"
 #include "rascal_sim/SherdMeshBuilder.hpp"
-#include "rascal_sim/ScenarioLoader.hpp"
-#include "rascal_sim/Simulator.hpp"
-#include "rascal_sim/MunsellTable.hpp"
 
 using namespace rascal_perception;
 using namespace rascal_perception_test;
@@ -497,42 +494,3 @@ TEST(StackedSherds, ASherdOnAnotherIsCutOutAlongItsStepAndOfferedFirst) {
 }
 
 TEST(Print, SurveyJoints) { const auto& q = rascal_perception_test::surveyJoints(); std::printf("survey joints: %.4f %.4f %.4f %.4f %.4f %.4f\n", q[0], q[1], q[2], q[3], q[4], q[5]); }
-
-TEST(DebugHeap, Dump) {
-  const char* seed_env = std::getenv("HEAP_SEED");
-  if (!seed_env) GTEST_SKIP();
-  rascal_sim::Scenario sc = loadScenario("heap_20.yaml");
-  sc.seed = static_cast<unsigned>(std::atoi(seed_env));
-  sc = rascal_sim::ScenarioLoader(layout(), rascal_sim::MunsellTable(std::string(RASCAL_SIM_DATA_DIR) + "/munsell_soil_hues_grid_renotation.csv"))
-           .parse("seed: " + std::string(seed_env) + "\ngenerate: {count: 20, seed: " + seed_env + ", heap: {centre: [0.16, 0.25], spread: 0.03, drop_height: 0.01}}\n");
-  rascal_sim::SimulatorOptions o = simParameters().options;
-  o.initial_joints = surveyJoints();
-  o.archival_width = 64;
-  o.archival_height = 48;
-  rascal_sim::Simulator sim(layout(), o);
-  sim.load(sc);
-  for (int i = 0; i < 3000; ++i) sim.step();
-  rascal_sim::Simulator empty_sim(layout(), o);
-  empty_sim.load(emptyLike(sc));
-  const rascal_sim::WristFrame e = empty_sim.renderWristFrame();
-  const rascal_sim::WristFrame w = sim.renderWristFrame();
-  CameraView view;
-  const rascal_sim::CameraModel& m = sim.wristModel();
-  view.intrinsics = {m.width, m.height, m.fx, m.fy, m.cx, m.cy};
-  view.base_T_camera = w.world_T_camera;
-  SherdDetector d(config());
-  d.calibrate("pickup", e.rgb, e.depth_mm, view, pickupZ());
-  const DetectionResult r = d.detect("pickup", w.rgb, w.depth_mm, view, pickupZ());
-  for (const SherdDetection& s : r.sherds) {
-    std::printf("det %.3f %.3f L %.1f W %.1f H %.1f cov %.2f sup %.1f gw %.1f gz %.1f\n", s.centre.x(), s.centre.y(),
-                s.length * 1e3, s.width * 1e3, s.height * 1e3, s.covered, s.support * 1e3, s.grasp_width * 1e3,
-                s.grasp.translation().z() * 1e3);
-  }
-  for (const auto& t : sim.groundTruth()) {
-    std::printf("truth %s %.3f %.3f z %.1f L %.1f W %.1f\n", t.name.c_str(), t.pose.translation().x(),
-                t.pose.translation().y(), t.pose.translation().z() * 1e3, t.length * 1e3, t.width * 1e3);
-  }
-  cv::Mat bgr;
-  cv::cvtColor(Annotator::draw(w.rgb, r.sherds, cv::Mat(), &view), bgr, cv::COLOR_RGB2BGR);
-  cv::imwrite("/tmp/heap_dump.png", bgr);
-}
