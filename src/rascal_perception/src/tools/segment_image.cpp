@@ -33,7 +33,7 @@ const char* kHelp =
     "options:\n"
     "  --json [FILE], -j    the sherds as one JSON list, one object per sherd (id, length_mm,\n"
     "                       width_mm, area_mm2, px_per_cm, scale (\"12.10 px/cm\"), flags,\n"
-    "                       centre_px, box_px, angle_deg,\n"
+    "                       centre_px, box_px, length_px, width_px, angle_deg,\n"
     "                       area_px, colour): on stdout (no FILE, or '-'), else written to FILE as\n"
     "                       well as what stdout holds; a FILE not ending in .json needs --json=FILE\n"
     "  --report [FILE]      the whole result as one JSON object (summary, px/cm, the scale bar's\n"
@@ -155,8 +155,9 @@ void sherdJson(const PhotoResult& r, size_t i, std::ostream& o) {
   for (size_t k = 0; k < f.size(); ++k) o << (k ? ", " : "") << "\"" << f[k] << "\"";
   o << "], \"centre_px\": [" << b.center.x << ", " << b.center.y << "], \"box_px\": ["
     << std::max(b.size.width, b.size.height) << ", " << std::min(b.size.width, b.size.height)
-    << "], \"angle_deg\": " << b.angle << ", \"area_px\": " << s.blob.pixels << ", \"colour\": [" << s.colour[0]
-    << ", " << s.colour[1] << ", " << s.colour[2] << "]}";
+    << "], \"length_px\": " << std::max(b.size.width, b.size.height)
+    << ", \"width_px\": " << std::min(b.size.width, b.size.height) << ", \"angle_deg\": " << b.angle
+    << ", \"area_px\": " << s.blob.pixels << ", \"colour\": [" << s.colour[0] << ", " << s.colour[1] << ", " << s.colour[2] << "]}";
 }
 
 /// `--json`: the sherds as one JSON list on one line, the shape tools that read lists expect.
