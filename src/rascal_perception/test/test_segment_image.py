@@ -107,14 +107,32 @@ def test_json_on_stdout_is_one_list_of_sherds_however_asked(tmp_path, args):
     photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
     r = segment(*[a.format(p=photo) for a in args], "--no-overlay", cwd=tmp_path)
     assert r.returncode in (0, 1), r.stderr
-    sherds = json.loads(r.stdout)  # nothing but the JSON, even with stderr merged in
-    assert r.stderr == "" and r.stdout.count("\n") == 1  # one line: line readers take it too
+    sherds = json.loads(r.stdout)  # nothing but the JSON
+    assert r.stdout.count("\n") == 1  # one line: line readers take it too
     assert isinstance(sherds, list) and len(sherds) == photo_result(photo)["sherd_count"] >= 1
+    # the summary line a person reads, on stderr apart from the JSON
+    assert r.stderr == "segment_image: %s\n" % photo_result(photo)["summary"]
+    assert "%.2f px/cm" % photo_result(photo)["px_per_cm"] in r.stderr
     for s in sherds:
         assert s["px_per_cm"] == photo_result(photo)["px_per_cm"]
         assert s["scale"] == "%.2f px/cm" % s["px_per_cm"]
         assert s["length_mm"] >= s["width_mm"] > 0 and isinstance(s["flags"], list)
     assert not list(tmp_path.iterdir())  # the photo's name was not taken for a JSON file
+
+
+def test_json_with_stderr_merged_into_stdout_still_parses(tmp_path):
+    photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
+    r = subprocess.run(
+        [TOOL, photo, "--json", "--no-overlay"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        timeout=60,
+        cwd=tmp_path,
+        check=False,
+    )
+    assert r.returncode in (0, 1)
+    assert len(json.loads(r.stdout)) == photo_result(photo)["sherd_count"]  # no summary mixed in
 
 
 def test_report_on_stdout_is_one_object_with_the_photo_wide_findings(tmp_path):
@@ -134,7 +152,7 @@ def test_a_read_only_folder_only_warns_about_the_default_overlay(tmp_path):
     ro.chmod(0o555)
     try:
         r = segment(photo, "--format", "table", cwd=ro)
-        quiet = segment(photo, "--json", cwd=ro)  # JSON for a program: stderr stays empty
+        quiet = segment(photo, "--json", cwd=ro)  # JSON for a program: no warning
     finally:
         ro.chmod(0o755)
     if os.geteuid() == 0:  # root writes anyway: the overlay is simply there
@@ -142,7 +160,8 @@ def test_a_read_only_folder_only_warns_about_the_default_overlay(tmp_path):
     else:
         assert "warning: cannot write the overlay" in r.stderr
     assert r.returncode in (0, 1) and "length mm" in r.stdout
-    assert quiet.returncode in (0, 1) and quiet.stderr == "" and json.loads(quiet.stdout)
+    assert quiet.returncode in (0, 1) and json.loads(quiet.stdout)
+    assert "warning" not in quiet.stderr and len(quiet.stderr.splitlines()) == 1  # the summary
 
 
 def test_overlay_is_written_where_asked_and_by_default_beside(tmp_path):

@@ -1,5 +1,6 @@
 // segment_image: sherds and the scale bar in a photo (no ROS). `segment_image --help` says it all.
 #include <getopt.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,6 +23,13 @@
 using namespace rascal_perception;
 
 namespace {
+/// Whether two descriptors are one open file (`2>&1`): same device and inode.
+bool sameFile(int a, int b) {
+  struct stat sa {}, sb {};
+  if (fstat(a, &sa) != 0 || fstat(b, &sb) != 0) return false;
+  return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
 constexpr int kConfident = 0, kDoubtful = 1, kBadInput = 2;
 
 const char* kHelp =
@@ -40,8 +48,9 @@ const char* kHelp =
     "                       box and doubt, the photo-wide doubts and the sherds): on stdout or FILE\n"
     "  --format table|json|report\n"
     "                       what stdout holds; without it, the table on a terminal and the JSON\n"
-    "                       list when stdout is a pipe or a file. With JSON on stdout nothing else\n"
-    "                       is printed (no summary line on stderr: the exit code and the flags say it)\n"
+    "                       list when stdout is a pipe or a file. With JSON, stdout holds only\n"
+    "                       the JSON; the one-line summary (count, px/cm, doubts) goes to stderr\n"
+    "                       unless stderr is stdout (2>&1), so merged output still parses\n"
     "  --overlay FILE       write the overlay image there (default: PHOTO-STEM_segmented.jpg in the\n"
     "                       current folder): outlines and ids, flagged sherds in orange, the bar\n"
     "  --no-overlay         write no overlay image\n"
@@ -376,6 +385,10 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return badUsage(e.what());
   }
-  if (format == "table") std::fprintf(stderr, "segment_image: %s\n", summaryOf(r).c_str());
+  // The summary (count, px/cm, doubts) goes to stderr for a person or a log, except when stderr
+  // is the very pipe or file stdout is: there it would spoil the JSON a program parses.
+  if (format == "table" || (format == "json" && !sameFile(STDOUT_FILENO, STDERR_FILENO))) {
+    std::fprintf(stderr, "segment_image: %s\n", summaryOf(r).c_str());
+  }
   return doubts(r).empty() ? kConfident : kDoubtful;
 }
