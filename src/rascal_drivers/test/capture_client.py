@@ -16,7 +16,7 @@ def main():
     capture = rospy.ServiceProxy("/archival_camera/capture", CaptureArchival)
     out = []
     for path in sys.argv[1:]:
-        res = capture(path)
+        res = capture(path=path)
         out.append(
             {
                 "success": res.success,

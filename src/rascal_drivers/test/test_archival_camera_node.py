@@ -81,3 +81,81 @@ def test_an_empty_or_undecodable_file_is_never_reported_as_an_image(tmp_path):
     with pytest.raises(CaptureError, match="empty image"):
         store_png(cv2, np.zeros((0, 0, 3), np.uint8), str(tmp_path / "out.png"))
     assert not (tmp_path / "out.png").exists()
+
+
+class _Gphoto:
+    """python3-gphoto2's surface as GphotoCamera uses it, for a camera whose shutter speeds are
+    the usual third stops: records the shutter speed of every capture."""
+
+    GP_CAPTURE_IMAGE, GP_FILE_TYPE_NORMAL = 0, 1
+    SPEEDS = ["1/15", "1/20", "1/25", "1/30", "1/40", "1/50", "1/60", "1/80", "1/100", "1/125"]
+    SPEEDS += ["1/160", "1/200", "1/250"]
+
+    class GPhoto2Error(Exception):
+        pass
+
+    def __init__(self, jpeg):
+        self.settings, self.shots, self.jpeg = {}, [], jpeg
+        gp = self
+
+        class Widget:
+            def __init__(self, name, choices):
+                self.name, self.choices = name, choices
+
+            def count_choices(self):
+                return len(self.choices)
+
+            def get_choice(self, i):
+                return self.choices[i]
+
+            def set_value(self, v):
+                gp.pending[self.name] = v
+
+        class Config:
+            def get_child_by_name(self, name):
+                choices = {"shutterspeed": gp.SPEEDS, "iso": ["100", "200"], "colortemperature": []}
+                return Widget(name, choices[name])
+
+        class File:
+            def save(self, path):
+                with open(path, "wb") as f:
+                    f.write(gp.jpeg)
+
+        class Where:
+            folder, name = "/store_00010001/DCIM", "IMG_0001.JPG"
+
+        class Camera:
+            def init(self):
+                pass
+
+            def get_config(self):
+                gp.pending = {}
+                return Config()
+
+            def set_config(self, _):
+                gp.settings.update(gp.pending)
+
+            def capture(self, _):
+                gp.shots.append(gp.settings["shutterspeed"])
+                return Where()
+
+            def file_get(self, *_):
+                return File()
+
+            def exit(self):
+                pass
+
+        self.Camera = Camera
+
+
+def test_a_dslr_shot_a_stop_darker_gets_half_the_shutter_time(tmp_path):
+    from rascal_drivers.archival_camera import GphotoCamera
+
+    _, jpeg = cv2.imencode(".jpg", np.full((30, 40, 3), 128, np.uint8))
+    gp = _Gphoto(jpeg.tobytes())
+    cfg = read_section({"kind": "gphoto2", "exposure": 1 / 60, "iso": 100}, PREFIX)
+    camera = GphotoCamera(gp, cv2, cfg)
+    camera.open()
+    for ev in (0.0, -1.0, -2.0, 0.0):
+        assert camera.capture(str(tmp_path / "a.png"), ev) == (40, 30)
+    assert gp.shots == ["1/60", "1/125", "1/250", "1/60"]  # the nearest the camera offers

@@ -7,6 +7,8 @@ import os
 import struct
 import time
 
+import cv2
+import numpy as np
 import pytest
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
@@ -45,9 +47,14 @@ def move_arm(master, joints, seconds=2.0):
     raise AssertionError("arm did not reach %s (at %s)" % (joints, q))
 
 
-def capture(master, path):
+def capture(master, path, exposure_ev=0.0):
     return master.run(
-        ["rosservice", "call", "/archival_camera/capture", "{path: '%s'}" % path]
+        [
+            "rosservice",
+            "call",
+            "/archival_camera/capture",
+            "{path: '%s', exposure_ev: %g}" % (path, exposure_ev),
+        ]
     ).stdout
 
 
@@ -103,6 +110,16 @@ def test_capture_refused_while_arm_in_view_then_stored(ros_master, sim, tmp_path
         header = f.read(24)
     width, height = struct.unpack(">II", header[16:24])
     assert (width, height) == (2000, 1500)
+
+    # a stop darker: half the light on the sensor (compared in linear light, unclipped pixels)
+    darker = tmp_path / "darker.png"
+    assert "success: True" in capture(ros_master, str(darker), -1.0)
+    a, b = (cv2.imread(str(p)).astype(float) / 255.0 for p in (path, darker))
+    ok = (a < 0.95) & (a > 0.05)
+    ratio = np.mean(b[ok] ** 2.2) / np.mean(a[ok] ** 2.2)
+    assert 0.35 < ratio < 0.65, ratio
+    out = capture(ros_master, str(tmp_path / "x.png"), -5.0)
+    assert "success: False" in out and "exposure_ev" in out
 
 
 def test_ground_truth_spawn_and_reset(ros_master, sim):

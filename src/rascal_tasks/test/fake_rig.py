@@ -9,6 +9,7 @@ weighs what lies on it. `Recorder` keeps the catalogue's status rules in memory.
 """
 
 import math
+import os
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
@@ -48,6 +49,11 @@ class World:
         self.refuse = lambda x, y, z, yaw, linear: None
         self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
         self.camera_refusals = 0  # captures to refuse before one succeeds
+        # photos written (into `photo_folder`) when set: a grey frame with a white patch of
+        # `photo_light` x 255 x 2^EV (clipped at 255), of 1 % of the frame; the EVs asked for
+        self.photo_folder: Optional[str] = None
+        self.photo_light = 0.8
+        self.exposures: List[float] = []
         self.tare = 0.0
         # sherd name -> the sherd lying under it that its first grasp lifts too (a heap); set
         # down together, the second lands `DOUBLE_APART` from the first
@@ -202,11 +208,21 @@ class _Camera(rig.ArchivalCamera):
     def __init__(self, world):
         self.w = world
 
-    def capture(self, path):
+    def capture(self, path, exposure_ev=0.0):
         if self.w.camera_refusals > 0:
             self.w.camera_refusals -= 1
             raise rig.RigError("/archival_camera/capture", "REFUSED", "cannot write " + path)
-        return rig.Capture(path, self.w.t, 2000, 1500)
+        self.w.exposures.append(exposure_ev)
+        if self.w.photo_folder is None:
+            return rig.Capture(path, self.w.t, 2000, 1500)
+        import cv2
+        import numpy as np
+
+        img = np.full((150, 200, 3), 90, np.uint8)
+        img[:15, :20] = min(255, round(self.w.photo_light * 255 * 2.0**exposure_ev))
+        path = os.path.join(self.w.photo_folder, os.path.basename(path))
+        cv2.imwrite(path, img)
+        return rig.Capture(path, self.w.t, 200, 150)
 
 
 class _Clock(rig.Clock):

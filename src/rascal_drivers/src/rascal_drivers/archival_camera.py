@@ -2,9 +2,11 @@
 OpenCV (V4L2), each taking one still on request and leaving a checked PNG where it was asked.
 
 Both fix exposure and white balance from the configuration, so every sherd of a batch is shot
-under the same settings (the colour chart in view is only comparable that way). Every stored
-image is read back and decoded before it is reported: an empty or undecodable file is an error,
-never a catalogue row. No ROS here; cv2 and gphoto2 are injected by the node.
+under the same settings (the colour chart in view is only comparable that way); a capture may ask
+for whole stops less (or more) light than configured, which the shutter time gives (the task
+layer steps down when highlights clip; the chart in view corrects the photo either way). Every
+stored image is read back and decoded before it is reported: an empty or undecodable file is an
+error, never a catalogue row. No ROS here; cv2 and gphoto2 are injected by the node.
 """
 
 import os
@@ -55,6 +57,7 @@ class OpenCvCamera:
         self.device = config["device"]
         self.v4l2 = self.device.startswith("/dev/video")
         self.capture_ = None
+        self.exposure_ev = 0.0
 
     def open(self) -> None:
         cv2, c = self.cv2, self.config
@@ -70,11 +73,20 @@ class OpenCvCamera:
             self.capture_.set(cv2.CAP_PROP_FRAME_WIDTH, width)
             self.capture_.set(cv2.CAP_PROP_FRAME_HEIGHT, height)
             self.capture_.set(cv2.CAP_PROP_AUTO_EXPOSURE, 1)  # V4L2: 1 = manual exposure
-            self.capture_.set(cv2.CAP_PROP_EXPOSURE, c["exposure"] * 1e4)  # V4L2: 100 us units
+            self._set_exposure(0.0)
             self.capture_.set(cv2.CAP_PROP_AUTO_WB, 0)
             self.capture_.set(cv2.CAP_PROP_WB_TEMPERATURE, c["white_balance"])
 
-    def capture(self, path: str) -> Tuple[int, int]:
+    def _set_exposure(self, exposure_ev: float) -> None:
+        seconds = self.config["exposure"] * 2.0**exposure_ev
+        self.capture_.set(self.cv2.CAP_PROP_EXPOSURE, seconds * 1e4)  # V4L2: 100 us units
+        self.exposure_ev = exposure_ev
+
+    def capture(self, path: str, exposure_ev: float = 0.0) -> Tuple[int, int]:
+        """A still at `exposure_ev` stops from the configured exposure (a file or an image
+        sequence has no exposure: there it is the source's own)."""
+        if self.v4l2 and exposure_ev != self.exposure_ev:
+            self._set_exposure(exposure_ev)
         if self.v4l2:
             for _ in range(self.FLUSH_FRAMES):
                 self.capture_.grab()
@@ -119,6 +131,7 @@ class GphotoCamera:
         self.cv2 = cv2
         self.config = config
         self.camera = None
+        self.exposure_ev = 0.0
 
     def open(self) -> None:
         gp = self.gp
@@ -133,11 +146,12 @@ class GphotoCamera:
             ) from e
         self._configure()
 
-    def _configure(self) -> None:
+    def _configure(self, exposure_ev: float = 0.0) -> None:
         c = self.config
         config = self.camera.get_config()
+        shutter = c["exposure"] * 2.0**exposure_ev  # the nearest the camera offers
         settings = (
-            ("shutterspeed", "drivers.archival_camera.exposure", c["exposure"], _shutter_seconds),
+            ("shutterspeed", "drivers.archival_camera.exposure", shutter, _shutter_seconds),
             ("iso", "drivers.archival_camera.iso", c["iso"], float),
         )
         for name, key, value, parse in settings:
@@ -158,9 +172,13 @@ class GphotoCamera:
                 % (e, c["white_balance"])
             ) from e
         self.camera.set_config(config)
+        self.exposure_ev = exposure_ev
 
-    def capture(self, path: str) -> Tuple[int, int]:
+    def capture(self, path: str, exposure_ev: float = 0.0) -> Tuple[int, int]:
+        """A still at `exposure_ev` stops from the configured shutter time."""
         gp = self.gp
+        if exposure_ev != self.exposure_ev:
+            self._configure(exposure_ev)
         try:
             where = self.camera.capture(gp.GP_CAPTURE_IMAGE)
             camera_file = self.camera.file_get(where.folder, where.name, gp.GP_FILE_TYPE_NORMAL)

@@ -96,9 +96,12 @@ class Simulator {
   const CameraModel& wristModel() const { return options_.wrist_model; }
 
   ArchivalCamera& archival() { return archival_; }
-  /// Renders the archival view now (no noise budget for the shutter; used by the capture and tools).
-  cv::Mat renderArchival();
-  bool triggerCapture(std::string& why);
+  /// Renders the archival view now (no noise budget for the shutter; used by the capture and tools),
+  /// `exposure_ev` stops brighter (+) or darker (-) than the camera's configured exposure.
+  cv::Mat renderArchival(double exposure_ev = 0.0);
+  /// Starts a capture at `exposure_ev` (within +-kMaxExposureEv); false and `why` when refused.
+  bool triggerCapture(std::string& why, double exposure_ev = 0.0);
+  static constexpr double kMaxExposureEv = 3.0;
 
   bool injectFault(int fault, double duration, std::string& message);
   std::vector<SherdState> groundTruth() const;
@@ -128,6 +131,7 @@ class Simulator {
   double next_wrist_frame_ = 0.0;
   bool scale_fresh_ = false;
   bool drop_next_grasp_ = false;
+  double capture_exposure_ev_ = 0.0;  ///< of the capture under way
   double camera_fault_until_ = -1.0;
   // grasp bookkeeping
   double grasp_z_ = 0.0;

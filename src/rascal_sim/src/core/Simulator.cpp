@@ -116,7 +116,7 @@ void Simulator::step() {
   world_.step(dt);
   updateGrasp();
   if (scale_.update(time(), dt, world_.scaleLoad())) scale_fresh_ = true;
-  if (archival_.update(time(), world_.armPose())) archival_.deliver(time(), renderArchival());
+  if (archival_.update(time(), world_.armPose())) archival_.deliver(time(), renderArchival(capture_exposure_ev_));
 }
 
 void Simulator::releaseByOpening() {
@@ -224,16 +224,23 @@ void Simulator::skipWristFrame() {
   while (next_wrist_frame_ <= time() + 1e-9) next_wrist_frame_ += period;
 }
 
-cv::Mat Simulator::renderArchival() {
+cv::Mat Simulator::renderArchival(double exposure_ev) {
   world_.renderItems(items_, true);
   RenderOutput out;
-  renderer_.render(items_, archival_.model(), archival_.pose(), out, SensorEffects::lightGain(scenario_.lighting));
+  // exposure scales the light reaching the sensor, before its tone curve clips
+  const Eigen::Vector3f gain = SensorEffects::lightGain(scenario_.lighting) * static_cast<float>(std::exp2(exposure_ev));
+  renderer_.render(items_, archival_.model(), archival_.pose(), out, gain);
   effects_.colourImage(out.colour, out.depth, archival_.model(), archival_.pose(), scenario_.lighting, time(), 0.0);
   SensorEffects::archivalCamera(out.colour, archival_.model());
   return out.colour;
 }
 
-bool Simulator::triggerCapture(std::string& why) {
+bool Simulator::triggerCapture(std::string& why, double exposure_ev) {
+  if (!(std::abs(exposure_ev) <= kMaxExposureEv)) {
+    why = "exposure_ev " + std::to_string(exposure_ev) + " outside -3..3 EV";
+    return false;
+  }
+  capture_exposure_ev_ = exposure_ev;
   return archival_.trigger(time(), time() < camera_fault_until_, camera_fault_until_, why);
 }
 

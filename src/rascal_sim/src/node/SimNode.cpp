@@ -235,7 +235,7 @@ bool SimNode::onCapture(rascal_msgs::CaptureArchival::Request& req, rascal_msgs:
     }
     std::unique_lock<std::mutex> lk(mutex_);
     std::string why;
-    if (!sim_->triggerCapture(why)) {
+    if (!sim_->triggerCapture(why, req.exposure_ev)) {
       res.success = false;
       res.message = why;
       return true;

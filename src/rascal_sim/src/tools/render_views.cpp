@@ -1,8 +1,9 @@
 // Renders the wrist and archival views of a scenario to PNG (no ROS):
-//   render_views <scenario.yaml> <out_dir> [archival_scale]
+//   render_views <scenario.yaml> <out_dir> [archival_scale [exposure_ev]]
 // The wrist view is taken from the survey height over the pickup mat with the gripper pointing
 // down; the archival view has the scenario's first sherd moved to the camera station's place_at,
-// the arm at its sleep pose (out of view). archival_scale < 1 shrinks the archival PNG for docs.
+// the arm at its sleep pose (out of view). archival_scale < 1 shrinks the archival PNG for docs;
+// exposure_ev shoots it that many stops brighter (+) or darker (-), as the capture service does.
 // The layout and options are the shipped config/rascal.yaml's, the finger limits the URDF's.
 #include <cmath>
 #include <cstdio>
@@ -53,12 +54,13 @@ void save(const std::string& path, const cv::Mat& rgb) {
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: render_views <scenario.yaml> <out_dir> [archival_scale]\n");
+    std::fprintf(stderr, "usage: render_views <scenario.yaml> <out_dir> [archival_scale [exposure_ev]]\n");
     return 2;
   }
   try {
     const std::string data = RASCAL_SIM_DATA_DIR, out = argv[2];
     const double scale = argc > 3 ? std::stod(argv[3]) : 1.0;
+    const double exposure_ev = argc > 4 ? std::stod(argv[4]) : 0.0;
     const SimParameters config = SimParameters::read(
         rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sim"),
         rascal_workcell::GripperGeometry::fromPackageUrdf(), data);
@@ -86,7 +88,7 @@ int main(int argc, char** argv) {
     Simulator archival(layout, a);
     archival.load(scenario);
     for (int i = 0; i < 300; ++i) archival.step();
-    cv::Mat img = archival.renderArchival();
+    cv::Mat img = archival.renderArchival(exposure_ev);
     if (scale > 0 && scale < 1) cv::resize(img, img, cv::Size(), scale, scale, cv::INTER_AREA);
     save(out + "/sim_archival.png", img);
   } catch (const std::exception& e) {

@@ -158,7 +158,8 @@ class Scale:
 
 
 class ArchivalCamera:
-    def capture(self, path: str) -> Capture:
+    def capture(self, path: str, exposure_ev: float = 0.0) -> Capture:
+        """One photo stored at `path`, `exposure_ev` stops from the configured exposure."""
         raise NotImplementedError
 
 

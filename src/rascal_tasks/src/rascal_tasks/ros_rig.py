@@ -388,10 +388,11 @@ class RosArchivalCamera(rig.ArchivalCamera):
         self._stop = stop
         self._capture = _proxy("/archival_camera/capture", CaptureArchival)
 
-    def capture(self, path):
+    def capture(self, path, exposure_ev=0.0):
         res = _call(
             self._capture,
             path,
+            exposure_ev,
             seconds=self.timeout,
             stop=self._stop,
             device="/archival_camera/capture",

@@ -10,6 +10,8 @@ No ROS here: plug-ins use the rig interfaces (`rig.py`) and write through the sh
 import math
 from typing import Dict, List, Optional, Tuple, Type
 
+from rascal_tasks.archival import exposure
+from rascal_tasks.archival.exposure import Exposure
 from rascal_tasks.rig import RigError, ScaleReading
 
 STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
@@ -256,8 +258,15 @@ class ScaleStation(StationPlugin):
 
 @station_type("archival_camera")
 class ArchivalCameraStation(StationPlugin):
+    """The archival photo, shot again a stop darker (twice at most) while its highlights clip
+    (archival.exposure); the darker exposure is kept for the batch's next sherds."""
+
     status = "photographed"
     CAPTURE_ATTEMPTS = 3
+
+    def __init__(self, station, batch):
+        super().__init__(station, batch)
+        self.exposure = Exposure()
 
     def after_place(self, sherd):
         b = self.batch
@@ -267,17 +276,35 @@ class ArchivalCameraStation(StationPlugin):
         cx, cy = self.station.area.center
         b.move_down(sx, sy, b.config["arm"]["travel_z"], math.atan2(sy - cy, sx - cx))
         with b.phase("data_collection"):
-            for attempt in range(self.CAPTURE_ATTEMPTS):
-                try:
-                    capture = b.rig.camera.capture(sherd.spool_path())
+            capture = self._capture(sherd)
+            while capture is not None:
+                seen = exposure.measure(capture.path)
+                darker = self.exposure.retake(seen)
+                if darker is None:
+                    self.exposure.settle(seen)
                     break
-                except RigError as e:
-                    b.event(sherd, "capture_failed", "attempt %d: %s" % (attempt + 1, e.reason))
-                    b.rig.clock.sleep(1.0)
-            else:
+                b.event(
+                    sherd,
+                    "exposure",
+                    "%.1f %% of the photo near clipping: shot again at %+.0f EV"
+                    % (100.0 * seen.near_clip_share, darker),
+                )
+                capture = self._capture(sherd)
+            if capture is None:
                 return "failed"  # it lies on the camera's spot: the batch stops
             sherd.record_photo(capture.path)
         return "done"
+
+    def _capture(self, sherd):
+        """The capture at the batch's exposure, CAPTURE_ATTEMPTS tries; None when all failed."""
+        b = self.batch
+        for attempt in range(self.CAPTURE_ATTEMPTS):
+            try:
+                return b.rig.camera.capture(sherd.spool_path(), self.exposure.ev)
+            except RigError as e:
+                b.event(sherd, "capture_failed", "attempt %d: %s" % (attempt + 1, e.reason))
+                b.rig.clock.sleep(1.0)
+        return None
 
 
 @station_type("discard")
