@@ -49,6 +49,11 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
             assert r["vessel_diameter_mm"] is not None, (r["seq"], name, r)
             assert abs(r["vessel_diameter_mm"] / outer - 1) < 0.15, (r["seq"], name, outer, r)
     assert len(names) == 3, recorded
+    # Every column is measured (issue 15): none empty on all three rows, but those that only a
+    # condition fills (no stable mass, lost, a sorting bin configured).
+    conditional = {"mass_missing_reason", "lost_reason", "lost_at", "bin"}
+    empty = [c for c in recorded[0] if c not in conditional and all(r[c] is None for r in recorded)]
+    assert empty == [], (empty, recorded)
     # The archival image exists, is the one recorded, and shows something on the mat.
     import cv2
     import hashlib

@@ -249,6 +249,7 @@ class Row:
     notes: List[str] = field(default_factory=list)
     size: tuple = (None, None, None)  # length, width, thickness [m] the wrist camera measured
     bin: Optional[str] = None
+    seconds: Dict[str, Optional[float]] = field(default_factory=dict)  # pick, weigh, photo, discard
 
 
 class Recorder:
@@ -278,9 +279,10 @@ class Recorder:
         self.writes.append((status, seq))
         return row
 
-    def new_sherd(self, pickup_xy, attempts=1):
+    def new_sherd(self, pickup_xy, attempts=1, seconds=None):
         seq = max(self.sherds, default=0) + 1
         self.sherds[seq] = Row(seq, pickup_xy=tuple(pickup_xy))
+        self.sherds[seq].seconds["pick"] = seconds
         self.writes.append(("picked", seq))
         return seq
 
@@ -305,20 +307,23 @@ class Recorder:
         assert stable, "an unstable reading is never recorded as a mass"
         row = self._move(seq, "weighed")
         row.mass, row.mass_missing_reason = kg, None
+        row.seconds["weigh"] = seconds
 
     def mass_unstable(self, seq, reason, seconds=None):
         row = self._move(seq, "mass_unstable")
         row.mass, row.mass_missing_reason = None, reason
+        row.seconds["weigh"] = seconds
 
     def spool_path(self, seq):
         return "/spool/T-%d.png" % seq
 
     def photo(self, seq, image_path, seconds=None):
         self._move(seq, "photographed").image = image_path
+        self.sherds[seq].seconds["photo"] = seconds
         return image_path
 
     def done(self, seq, seconds=None, timings=None):
-        self._move(seq, "done")
+        self._move(seq, "done").seconds["discard"] = seconds
 
     def lost(self, seq, reason, timings=None):
         self._move(seq, "lost").lost_reason = reason

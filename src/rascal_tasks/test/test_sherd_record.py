@@ -67,6 +67,22 @@ def test_a_done_sherd_is_counted_completed(config):
     assert (b.completed, b.lost) == (1, 0) and b.sherd is None
 
 
+def test_each_stage_is_timed_on_the_rig_clock_from_where_the_last_ended(config):
+    b, world = _batch(config)
+    world.t = 10.0
+    b.timings = type(b.timings)(started=10.0)  # the last sherd ended at 10 s
+    world.t = 14.0
+    s = b.sherd = SherdRecord.picked(b, _obs(0.1, 0.2), b.pickup, attempts=1)
+    world.t = 20.5
+    s.record_mass(0.025, stable=True)
+    world.t = 23.0
+    s.record_photo("/spool/T-1.png")
+    world.t = 27.0
+    s.done()
+    assert b.recorder.sherds[1].seconds == {"pick": 4.0, "weigh": 6.5, "photo": 2.5, "discard": 4.0}
+    assert b.timings.started == 27.0  # the next sherd's time starts when this one is done
+
+
 def test_a_sherd_not_found_after_a_restart_is_lost_through_the_same_path(config):
     # sherd 2 was weighed when the run was killed; nothing lies anywhere now
     rec = Recorder(unfinished=[(2, "weighed", (0.15, 0.22))])

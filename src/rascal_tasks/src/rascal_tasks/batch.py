@@ -43,7 +43,7 @@ class Batch:
         self.log = log or (lambda msg: None)
         self.sherd: Optional[SherdRecord] = None
         # Time spent for the sherd in progress (or the next one: surveying counts for it).
-        self.timings = Timings()
+        self.timings = Timings(started=rig.clock.now())
         self.state_times = {}  # state label -> seconds, for the summary and the benchmark
         self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
         self.misses = {}  # rounded (x, y) -> pickups that failed there

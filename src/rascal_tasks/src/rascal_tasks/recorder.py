@@ -65,9 +65,10 @@ class Recorder:
             self._ids.update({r["seq"]: r["sherd_id"] for r in rows})
         return self._ids[seq]
 
-    def new_sherd(self, pickup_xy, attempts: int = 1) -> int:
+    def new_sherd(self, pickup_xy, attempts: int = 1, seconds: float = None) -> int:
+        """Number the sherd just picked; `seconds` it took to find and pick it (t_pick_s)."""
         rec = self.catalogue.new_sherd(
-            self.context, pickup_xy=list(pickup_xy), grasp_attempts=attempts
+            self.context, pickup_xy=list(pickup_xy), grasp_attempts=attempts, t_pick_s=seconds
         )
         self._ids[rec["seq"]] = rec["sherd_id"]
         return rec["seq"]

@@ -92,7 +92,7 @@ class Calibrate(BatchState):
             b.rig.perception.calibrate(st.name)
             if st.type == "discard":
                 b.rig.perception.calibrate(b.pickup.name)
-        b.timings = Timings()  # set-up is the batch's, not the first sherd's
+        b.timings = Timings(started=b.rig.clock.now())  # set-up is the batch's, not the sherd's
         return "done"
 
 

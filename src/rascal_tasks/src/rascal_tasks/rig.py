@@ -77,6 +77,7 @@ class Timings:
     data_collection: float = 0.0
     perception: float = 0.0
     phases: dict = field(default_factory=dict)
+    started: float = 0.0  # rig clock when this sherd's time began (not a phase)
 
     def add(self, phase: str, seconds: float):
         setattr(self, phase, getattr(self, phase) + seconds)

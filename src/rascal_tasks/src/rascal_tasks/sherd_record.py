@@ -33,11 +33,14 @@ class SherdRecord:
         self.bin: Optional[str] = None  # the sorting bin it goes into (stations.DiscardStation)
         # The batch's timings since the last sherd ended: surveying counts for this one.
         self.timings: Timings = batch.timings
+        self._stage_from = batch.timings.started  # rig clock when its last stage ended
 
     @classmethod
     def picked(cls, batch, o: Observation, station, attempts: int) -> "SherdRecord":
         """Number a sherd now in the gripper, picked as `o` from `station`."""
-        rec = cls(batch, batch.recorder.new_sherd((o.x, o.y), attempts=attempts))
+        seconds = batch.rig.clock.now() - batch.timings.started  # finding and picking it
+        rec = cls(batch, batch.recorder.new_sherd((o.x, o.y), attempts=attempts, seconds=seconds))
+        rec._stage_from = batch.timings.started + seconds
         rec.seen(o, station)
         rec.picked_xy = (o.x, o.y)
         rec.record_dimensions(o)
@@ -95,19 +98,19 @@ class SherdRecord:
                 "SherdRecord.record_mass: sherd %d: an unstable reading is not a mass; "
                 "use record_mass_unstable" % self.seq
             )
-        self.batch.recorder.mass(self.seq, kg, True)
+        self.batch.recorder.mass(self.seq, kg, True, seconds=self._stage())
         self.mass, self.status = kg, "weighed"
 
     def record_mass_unstable(self, reason: str):
         """The scale gave no trustworthy mass: the row says why and has no mass."""
-        self.batch.recorder.mass_unstable(self.seq, reason)
+        self.batch.recorder.mass_unstable(self.seq, reason, seconds=self._stage())
         self.mass, self.status = None, "mass_unstable"
 
     def spool_path(self) -> str:
         return self.batch.recorder.spool_path(self.seq)
 
     def record_photo(self, path: str) -> str:
-        archived = self.batch.recorder.photo(self.seq, path)
+        archived = self.batch.recorder.photo(self.seq, path, seconds=self._stage())
         self.status = "photographed"
         return archived
 
@@ -116,12 +119,19 @@ class SherdRecord:
         self.batch.event(self, "dropped", where)
         self.batch.recorder.drop(self.seq, where)
 
+    def _stage(self) -> float:
+        """Seconds (rig clock) since its last stage ended: the catalogue's t_weigh_s, t_photo_s,
+        t_discard_s (each with the carrying there; t_pick_s is since the last sherd ended)."""
+        now = self.batch.rig.clock.now()
+        seconds, self._stage_from = max(0.0, now - self._stage_from), now
+        return seconds
+
     def note(self, text: str):
         self.batch.recorder.note(self.seq, text)
 
     def done(self):
         self._must_be_open("done")
-        self.batch.recorder.done(self.seq, timings=self.timings.as_dict())
+        self.batch.recorder.done(self.seq, seconds=self._stage(), timings=self.timings.as_dict())
         self._finish("done")
 
     def lose(self, reason: str):
@@ -148,4 +158,4 @@ class SherdRecord:
             b.lost += 1
         if b.sherd is self:
             b.sherd = None
-        b.timings = Timings()  # the next sherd's time starts now
+        b.timings = Timings(started=b.rig.clock.now())  # the next sherd's time starts now
