@@ -123,8 +123,12 @@ void score(const Frame& f, const DetectionResult& r, Tally& t, const std::string
         t.diameter.push_back(std::fabs(s.diameter / truth - 1.0));
         t.diameter_z.push_back(std::fabs(s.diameter - truth) / s.diameter_sigma);
       }
-    } else if (s.diameter > 0.0) {
-      t.diameter.push_back(std::fabs(s.diameter * g.curvature / 2.0 - 1.0));  // "flat": any is wrong
+    } else {
+      if (std::getenv("RASCAL_PERCEPTION_VERBOSE")) {
+        std::printf("diameter flat %s: c %.1f | got %.0f ± %.0f (%s)\n", tag.c_str(), g.curvature, s.diameter * 1e3,
+                    s.diameter_sigma * 1e3, s.diameter_why.c_str());
+      }
+      if (s.diameter > 0.0) t.diameter.push_back(std::fabs(s.diameter * g.curvature / 2.0 - 1.0));  // any is wrong
     }
     if (std::getenv("RASCAL_PERCEPTION_VERBOSE")) {
       std::printf("%s %s: truth %.1f x %.1f yaw %.1f | got %.1f x %.1f yaw %.1f | centre err %.2f mm\n", tag.c_str(),
@@ -212,8 +216,12 @@ TEST(SherdDetector, FindsTheSmallScenarioSherdsIncludingTheMesh) {
 
 TEST(SherdDetector, GeneratedScenesUnderFieldLighting) {
   // 50 scenes, 6..10 sherds each, brightness 0.3 .. 1.5, 3000 .. 9000 K, shadows up to 0.5
+  // RASCAL_PERCEPTION_SEED0=N runs seeds N+1..N+50 instead (held-out checks; the limits below
+  // are for seeds 1-50)
+  const char* seed0_text = std::getenv("RASCAL_PERCEPTION_SEED0");
+  const unsigned seed0 = seed0_text ? static_cast<unsigned>(std::stoul(seed0_text)) : 0u;
   Tally t;
-  for (unsigned seed = 1; seed <= 50; ++seed) {
+  for (unsigned seed = seed0 + 1; seed <= seed0 + 50; ++seed) {
     const double brightness = 0.3 + 1.2 * ((seed * 7) % 50) / 49.0;
     const double kelvin = 3000 + 6000 * ((seed * 13) % 50) / 49.0;
     const double shadow = 0.5 * ((seed * 3) % 5) / 4.0;
@@ -256,7 +264,7 @@ TEST(SherdDetector, GeneratedScenesUnderFieldLighting) {
               percentile(t.diameter_z, 0.5), percentile(t.diameter_z, 0.9));
   const double within = static_cast<double>(std::count_if(t.diameter.begin(), t.diameter.end(),
                                                           [](double e) { return e <= 0.15; }));
-  EXPECT_GE(within, 0.85 * t.diameter.size());  // seeds 1-50: 0.934; held out (201-260): 0.905
+  EXPECT_GE(within, 0.85 * t.diameter.size());  // seeds 1-50: 0.966; held out: 0.934-0.942
   EXPECT_GE(t.diameter_told, 0.7 * t.diameter_curved);
 }
 

@@ -22,12 +22,13 @@ Terms terms(double x, double y) {
 /// uncertainty from the fit's covariance (rms² (AᵀA)⁻¹, [mm²] on the coefficients) and the
 /// curvature across it (`other`, signed).
 void strongestCurvature(const Coefficients& c, const Eigen::Matrix<double, kTerms, kTerms>& cov, double& kappa,
-                        double& sigma, double& other) {
+                        double& sigma, double& other, Eigen::Vector2d& direction) {
   Eigen::Matrix2d hessian;
   hessian << 2.0 * c(3), c(4), c(4), 2.0 * c(5);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(hessian);
   const int k = std::fabs(eig.eigenvalues()(0)) >= std::fabs(eig.eigenvalues()(1)) ? 0 : 1;
   const Eigen::Vector2d v = eig.eigenvectors().col(k);
+  direction = v;
   // a tilted sherd: the graph's curvature along v at the centre, h'' / (1 + h'²)^1.5
   const double slope = c(1) * v.x() + c(2) * v.y();
   const double stretch = std::pow(1.0 + slope * slope, 1.5);
@@ -110,8 +111,18 @@ ShellFit ShellFit::estimate(const std::vector<TopSample>& samples) {
 
   // The vessel: the strongest curvature of the top surface is the vessel's around its axis.
   double kappa = 0.0, sigma = 0.0, other = 0.0;  // [1/mm]
+  Eigen::Vector2d along;
   const Eigen::Matrix<double, kTerms, kTerms> cov = (out.rms * 1e3) * (out.rms * 1e3) * ata.inverse();
-  strongestCurvature(coef, cov, kappa, sigma, other);
+  strongestCurvature(coef, cov, kappa, sigma, other, along);
+  // the depth the curve spans over the sherd's extent that way: chord e, sagitta e^2 kappa / 8
+  double lo = 1e9, hi = -1e9;
+  for (const TopSample& s : samples) {
+    const double u = along.x() * s.x + along.y() * s.y;
+    lo = std::min(lo, u);
+    hi = std::max(hi, u);
+  }
+  const double chord = std::max(0.0, hi - lo);  // [m]
+  const double sagitta = chord * chord * std::fabs(kappa) * 1e3 / 8.0;  // [m]
   out.concave_up = kappa > 0.0;
   const double radius = 1e-3 / std::max(std::fabs(kappa), 1e-9);  // [m] of the face that is up
   // the outer face is the top when convex; concave, the top is the inner face, a wall inside it
@@ -126,10 +137,11 @@ ShellFit ShellFit::estimate(const std::vector<TopSample>& samples) {
                   1.0 / std::fabs(kappa), 1.0 / std::max(std::fabs(other), 1e-9));
     out.diameter_why = text;
     out.diameter = out.diameter_sigma = 0.0;
-  } else if (out.diameter > kMaxDiameter || out.diameter_sigma > kMaxRelativeSigma * out.diameter) {
-    char text[160];
-    std::snprintf(text, sizeof(text), "too flat or too small to tell (%.0f ± %.0f mm)", out.diameter * 1e3,
-                  out.diameter_sigma * 1e3);
+  } else if (out.diameter > kMaxDiameter || out.diameter_sigma > kMaxRelativeSigma * out.diameter ||
+             sagitta < kMinSagitta) {
+    char text[200];
+    std::snprintf(text, sizeof(text), "too flat or too small to tell (%.0f ± %.0f mm; curve %.1f mm deep over %.0f mm)",
+                  out.diameter * 1e3, out.diameter_sigma * 1e3, sagitta * 1e3, chord * 1e3);
     out.diameter_why = text;
     out.diameter = out.diameter_sigma = 0.0;
   }
