@@ -60,6 +60,8 @@ struct Tally {
   std::vector<double> centre, size, yaw, height, centre_generator, size_generator, yaw_generator;
   std::vector<double> thickness, height_as_thickness;  // |error| of the wall thickness; of the height instead
   int no_thickness = 0;
+  // the same for the hard cases: strongly curved (>= 10 /m) and concave up (lying on its outside)
+  std::vector<double> thickness_curved, thickness_concave;
   // vessel diameter: relative |error| where told; |error| / sigma; how many were told of how many
   // curved enough (diameter <= ShellFit::kMaxDiameter)
   std::vector<double> diameter, diameter_z;
@@ -103,6 +105,8 @@ void score(const Frame& f, const DetectionResult& r, Tally& t, const std::string
     t.height.push_back(std::fabs(s.centre.z() - g.top));
     if (s.thickness > 0.0) {
       t.thickness.push_back(std::fabs(s.thickness - g.thickness));
+      if (g.curvature >= 10.0) t.thickness_curved.push_back(t.thickness.back());
+      if (!g.convex_up) t.thickness_concave.push_back(t.thickness.back());
       t.height_as_thickness.push_back(std::fabs(s.height - g.thickness));
     } else {
       ++t.no_thickness;
@@ -253,6 +257,14 @@ TEST(SherdDetector, GeneratedScenesUnderFieldLighting) {
               t.thickness.size(), t.no_thickness, 1e3 * percentile(t.thickness, 0.5),
               1e3 * percentile(t.thickness, 0.95), 1e3 * percentile(t.thickness, 1.0),
               1e3 * percentile(t.height_as_thickness, 0.5), 1e3 * percentile(t.height_as_thickness, 0.95));
+  auto within_mm = [](const std::vector<double>& e) {
+    return static_cast<double>(std::count_if(e.begin(), e.end(), [](double x) { return x <= 0.001; })) /
+           std::max<size_t>(1, e.size());
+  };
+  std::printf("wall thickness within 1 mm: %.3f of %zu measured; strongly curved (>= 10 /m) %.3f of %zu; concave up "
+              "%.3f of %zu\n",
+              within_mm(t.thickness), t.thickness.size(), within_mm(t.thickness_curved), t.thickness_curved.size(),
+              within_mm(t.thickness_concave), t.thickness_concave.size());
   EXPECT_GE(t.thickness.size(), 0.95 * t.found);
   EXPECT_LE(percentile(t.thickness, 0.95), 0.001);
   std::printf("vessel diameter: told for %d of %d curved sherds (and %zu in all); relative |error| median %.3f, "
