@@ -115,34 +115,39 @@ class Repick(BatchState):
         return "Repick@%s" % self.batch.station_names[self.index]
 
     def run(self):
-        b = self.batch
-        s = b.sherd
-        st = b.config.stations[b.station_names[self.index]]
-        x, y = s.last_xy
-        blind = Observation(
-            x,
-            y,
-            s.grasp_yaw,
-            s.observation.length,
-            s.width,
-            0.0,
-            x,
-            y,
-            st.surface_z + s.grasp_height,
-            s.grasp_yaw,
-            opening_for(s.width, b.config["arm"]["grasp_margin"]),
-        )
-        o = blind
-        for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
-            if grasp(b, o, st):
-                return "held"
-            seen = survey_at(b, st, x, y)
-            if not seen:
-                break
-            o = seen[0]
-            s.grasped_as(o, st)
-        s.lose("could not pick it up again at %s" % st.name)
-        return "lost"
+        return "held" if repick(self.batch, self.index) else "lost"
+
+
+def repick(b, index) -> bool:
+    """Pick the sherd in progress up again where it was set down at station `index`: blind
+    first (where it was placed, as it was held), then from a fresh look on each miss. False,
+    with the sherd recorded lost, when it could not be taken."""
+    s = b.sherd
+    st = b.config.stations[b.station_names[index]]
+    x, y = s.last_xy
+    o = Observation(
+        x,
+        y,
+        s.grasp_yaw,
+        s.observation.length,
+        s.width,
+        0.0,
+        x,
+        y,
+        st.surface_z + s.grasp_height,
+        s.grasp_yaw,
+        opening_for(s.width, b.config["arm"]["grasp_margin"]),
+    )
+    for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
+        if grasp(b, o, st):
+            return True
+        seen = survey_at(b, st, x, y)
+        if not seen:
+            break
+        o = seen[0]
+        s.grasped_as(o, st)
+    s.lose("could not pick it up again at %s" % st.name)
+    return False
 
 
 class PutBack(BatchState):
@@ -165,8 +170,8 @@ class PutBack(BatchState):
         b = self.batch
         s = b.sherd
         st = b.config.stations[b.station_names[self.index]]
-        if Repick(b, self.index).run() != "held":
-            return "lost"  # Repick recorded it lost (the two lie at the station, for a person)
+        if not repick(b, self.index):
+            return "lost"  # recorded lost (the two lie at the station, for a person)
         spots = [free_spot(b.pickup.area, b.seen)]
         self._set_down(*spots[0])
         plugin = b.plugins[self.index]
