@@ -49,6 +49,7 @@ class World:
         self.refuse = lambda x, y, z, yaw, linear: None
         self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
         self.camera_refusals = 0  # captures to refuse before one succeeds
+        self.camera_refuses = lambda exposure_ev: False  # and any capture this says
         # photos written (into `photo_folder`) when set: a grey frame with a white patch of
         # `photo_light` x 255 x 2^EV (clipped at 255), of 1 % of the frame; the EVs asked for
         self.photo_folder: Optional[str] = None
@@ -209,8 +210,8 @@ class _Camera(rig.ArchivalCamera):
         self.w = world
 
     def capture(self, path, exposure_ev=0.0):
-        if self.w.camera_refusals > 0:
-            self.w.camera_refusals -= 1
+        if self.w.camera_refusals > 0 or self.w.camera_refuses(exposure_ev):
+            self.w.camera_refusals = max(0, self.w.camera_refusals - 1)
             raise rig.RigError("/archival_camera/capture", "REFUSED", "cannot write " + path)
         self.w.exposures.append(exposure_ev)
         if self.w.photo_folder is None:

@@ -78,3 +78,27 @@ def test_the_station_retakes_a_clipped_photo_and_keeps_the_darker_exposure(confi
     assert notes[2] == notes[3] == []
     # the photo recorded is the darker one
     assert cv2.imread(rec.sherds[1].image)[0, 0, 0] == round(1.5 * 255 / 2)
+
+
+def test_a_darker_photo_that_fails_leaves_the_first_standing(config, tmp_path):
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    world.photo_folder = str(tmp_path)
+    world.photo_light = 1.5
+    world.camera_refuses = lambda ev: ev < 0  # every darker capture fails
+    rec = Recorder()
+    batch = workflow.Batch(config, world.rig(), rec, context="T", log=print)
+    assert workflow.build_machine(batch).execute() == "finished"
+    assert rec.status() == {1: "done"}
+    assert cv2.imread(rec.sherds[1].image)[0, 0, 0] == 255  # the clipped photo, not none
+    assert any("failed: it stands" in n for n in rec.sherds[1].notes)
+
+
+def test_the_photo_shot_again_goes_beside_and_the_first_is_removed(config, tmp_path):
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    world.photo_folder = str(tmp_path)
+    world.photo_light = 1.5
+    rec = Recorder()
+    batch = workflow.Batch(config, world.rig(), rec, context="T", log=print)
+    assert workflow.build_machine(batch).execute() == "finished"
+    assert sorted(os.listdir(tmp_path)) == ["T-1_ev-1.png"]
+    assert rec.sherds[1].image == str(tmp_path / "T-1_ev-1.png")

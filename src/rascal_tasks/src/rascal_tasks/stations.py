@@ -8,6 +8,7 @@ No ROS here: plug-ins use the rig interfaces (`rig.py`) and write through the sh
 """
 
 import math
+import os
 from typing import Dict, List, Optional, Tuple, Type
 
 from rascal_tasks.archival import exposure
@@ -276,35 +277,46 @@ class ArchivalCameraStation(StationPlugin):
         cx, cy = self.station.area.center
         b.move_down(sx, sy, b.config["arm"]["travel_z"], math.atan2(sy - cy, sx - cx))
         with b.phase("data_collection"):
-            capture = self._capture(sherd)
-            while capture is not None:
+            capture = self._capture(sherd, sherd.spool_path())
+            if capture is None:
+                return "failed"  # it lies on the camera's spot: the batch stops
+            while True:
                 seen = exposure.measure(capture.path)
                 darker = self.exposure.retake(seen)
                 if darker is None:
                     self.exposure.settle(seen)
                     break
-                b.event(
-                    sherd,
-                    "exposure",
-                    "%.1f %% of the photo near clipping: shot again at %+.0f EV"
-                    % (100.0 * seen.near_clip_share, darker),
-                )
-                capture = self._capture(sherd)
-            if capture is None:
-                return "failed"  # it lies on the camera's spot: the batch stops
+                why = "%.1f %% of the photo near clipping" % (100.0 * seen.near_clip_share)
+                # a file of its own: a retake that fails leaves the photo taken intact
+                base, ext = os.path.splitext(sherd.spool_path())
+                retaken = self._capture(sherd, "%s_ev%+.0f%s" % (base, darker, ext))
+                if retaken is None:
+                    b.event(sherd, "exposure", why + "; shot again darker, failed: it stands")
+                    break
+                b.event(sherd, "exposure", why + ": shot again at %+.0f EV" % darker)
+                _discard(capture.path)
+                capture = retaken
             sherd.record_photo(capture.path)
         return "done"
 
-    def _capture(self, sherd):
+    def _capture(self, sherd, path):
         """The capture at the batch's exposure, CAPTURE_ATTEMPTS tries; None when all failed."""
         b = self.batch
         for attempt in range(self.CAPTURE_ATTEMPTS):
             try:
-                return b.rig.camera.capture(sherd.spool_path(), self.exposure.ev)
+                return b.rig.camera.capture(path, self.exposure.ev)
             except RigError as e:
                 b.event(sherd, "capture_failed", "attempt %d: %s" % (attempt + 1, e.reason))
                 b.rig.clock.sleep(1.0)
         return None
+
+
+def _discard(path: str) -> None:
+    """A spooled photo that is not the archival one (shot again darker)."""
+    try:
+        os.unlink(path)
+    except OSError:
+        pass  # the camera's spool on another machine, or gone already
 
 
 @station_type("discard")
