@@ -82,7 +82,9 @@ def pg_dsn():
     yield dsn
     with admin.cursor() as cur:
         cur.execute(
-            "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s", (name,)
+            "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
+            " AND backend_type = 'client backend'",
+            (name,),
         )
         cur.execute("DROP DATABASE IF EXISTS " + name)
     admin.close()

@@ -88,7 +88,8 @@ def block_database(admin_dsn, dsn, allow):
             if not allow:
                 cur.execute(
                     "SELECT pg_terminate_backend(pid) FROM pg_stat_activity "
-                    "WHERE datname = %s AND pid <> pg_backend_pid()",
+                    "WHERE datname = %s AND pid <> pg_backend_pid()"
+                    " AND backend_type = 'client backend'",
                     (name,),
                 )
     finally:

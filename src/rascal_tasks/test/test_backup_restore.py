@@ -40,7 +40,8 @@ def empty_db():
     with admin.cursor() as cur:
         for name in names:
             cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s",
+                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
+                " AND backend_type = 'client backend'",
                 (name,),
             )
             cur.execute("DROP DATABASE IF EXISTS " + name)

@@ -179,7 +179,8 @@ def test_a_copied_database_takes_an_identity_of_its_own(migrated_dsn):
     finally:
         with admin.cursor() as cur:
             cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s",
+                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
+                " AND backend_type = 'client backend'",
                 (copy,),
             )
             cur.execute("DROP DATABASE IF EXISTS " + copy)

@@ -120,7 +120,8 @@ def unchanged(tmp_path_factory):
     finally:
         with admin.cursor() as cur:
             cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s",
+                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
+                " AND backend_type = 'client backend'",
                 (name,),
             )
             cur.execute("DROP DATABASE IF EXISTS " + name)

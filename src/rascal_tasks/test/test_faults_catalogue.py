@@ -93,7 +93,8 @@ def fresh_database():
     finally:
         with admin.cursor() as cur:
             cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s",
+                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
+                " AND backend_type = 'client backend'",
                 (name,),
             )
             cur.execute("DROP DATABASE IF EXISTS " + name)
