@@ -103,13 +103,19 @@ def test_options_before_or_after_the_photo_give_the_same_result(tmp_path):
     ],
     ids=["json-last", "json-first", "format-json", "json-dash", "j", "piped"],
 )
-def test_json_on_stdout_is_one_list_of_sherds_however_asked(tmp_path, args):
+def test_json_on_stdout_is_one_line_with_the_sherds_and_px_per_cm_however_asked(tmp_path, args):
     photo = os.path.join(PHOTOS, "img040DSC02176.jpg")
     r = segment(*[a.format(p=photo) for a in args], "--no-overlay", cwd=tmp_path)
     assert r.returncode in (0, 1), r.stderr
-    sherds = json.loads(r.stdout)  # nothing but the JSON
+    d = json.loads(r.stdout)  # nothing but the JSON
     assert r.stdout.count("\n") == 1  # one line: line readers take it too
+    sherds = d["sherds"]
     assert isinstance(sherds, list) and len(sherds) == photo_result(photo)["sherd_count"] >= 1
+    assert d["sherd_count"] == len(sherds) and d["px_per_cm"] == photo_result(photo)["px_per_cm"]
+    assert d["scale"] == "%.2f px/cm" % d["px_per_cm"]
+    assert d["summary"] == photo_result(photo)["summary"]
+    # the list stands between the first '[' and the last ']' (readers that cut a list out)
+    assert json.loads(r.stdout[r.stdout.index("[") : r.stdout.rindex("]") + 1]) == sherds
     # the summary line a person reads, on stderr apart from the JSON
     assert r.stderr == "segment_image: %s\n" % photo_result(photo)["summary"]
     assert "%.2f px/cm" % photo_result(photo)["px_per_cm"] in r.stderr
@@ -132,7 +138,7 @@ def test_json_with_stderr_merged_into_stdout_still_parses(tmp_path):
         check=False,
     )
     assert r.returncode in (0, 1)
-    assert len(json.loads(r.stdout)) == photo_result(photo)["sherd_count"]  # no summary mixed in
+    assert len(json.loads(r.stdout)["sherds"]) == photo_result(photo)["sherd_count"]  # no summary
 
 
 def test_report_on_stdout_is_one_object_with_the_photo_wide_findings(tmp_path):
@@ -225,7 +231,7 @@ def test_a_photo_without_a_scale_bar_is_doubtful_and_says_so(tmp_path):
 def test_json_round_trip_matches_the_table(tmp_path):
     photo = os.path.join(PHOTOS, "img005DSC02101.jpg")
     r = segment(photo, "--json", str(tmp_path / "r.json"), "--format", "table", "--no-overlay")
-    sherds = json.loads((tmp_path / "r.json").read_text())
+    sherds = json.loads((tmp_path / "r.json").read_text())["sherds"]
     rows = r.stdout.strip().splitlines()[1:]
     assert len(rows) == len(sherds)
     for row, s in zip(rows, sherds, strict=True):

@@ -39,16 +39,17 @@ const char* kHelp =
     "photo of sherds on a cloth, and measures each sherd in mm once the bar is found.\n"
     "\n"
     "options:\n"
-    "  --json [FILE], -j    the sherds as one JSON list, one object per sherd (id, length_mm,\n"
-    "                       width_mm, area_mm2, px_per_cm, scale (\"12.10 px/cm\"), flags,\n"
-    "                       centre_px, box_px, length_px, width_px, angle_deg,\n"
-    "                       area_px, colour): on stdout (no FILE, or '-'), else written to FILE as\n"
+    "  --json [FILE], -j    one JSON object on one line: \"sherds\", a list of one object per sherd\n"
+    "                       (id, length_mm, width_mm, area_mm2, px_per_cm, scale (\"12.10 px/cm\"),\n"
+    "                       flags, centre_px, box_px, length_px, width_px, angle_deg, area_px,\n"
+    "                       colour), then sherd_count, px_per_cm (null without a bar), scale and\n"
+    "                       summary: on stdout (no FILE, or '-'), else written to FILE as\n"
     "                       well as what stdout holds; a FILE not ending in .json needs --json=FILE\n"
     "  --report [FILE]      the whole result as one JSON object (summary, px/cm, the scale bar's\n"
     "                       box and doubt, the photo-wide doubts and the sherds): on stdout or FILE\n"
     "  --format table|json|report\n"
     "                       what stdout holds; without it, the table on a terminal and the JSON\n"
-    "                       list when stdout is a pipe or a file. With JSON, stdout holds only\n"
+    "                       object when stdout is a pipe or a file. With JSON, stdout holds only\n"
     "                       the JSON; the one-line summary (count, px/cm, doubts) goes to stderr\n"
     "                       unless stderr is stdout (2>&1), so merged output still parses\n"
     "  --overlay FILE       write the overlay image there (default: PHOTO-STEM_segmented.jpg in the\n"
@@ -169,16 +170,24 @@ void sherdJson(const PhotoResult& r, size_t i, std::ostream& o) {
     << ", \"area_px\": " << s.blob.pixels << ", \"colour\": [" << s.colour[0] << ", " << s.colour[1] << ", " << s.colour[2] << "]}";
 }
 
-/// `--json`: the sherds as one JSON list on one line, the shape tools that read lists expect.
+/// `--json`: one line, {"sherds": [...], "sherd_count", "px_per_cm", "scale", "summary"}.
 std::string sherdList(const PhotoResult& r) {
   std::ostringstream o;
   twoDecimals(o);
-  o << "[";
+  o << "{\"sherds\": [";
   for (size_t i = 0; i < r.sherds.size(); ++i) {
     o << (i ? ", " : "");
     sherdJson(r, i, o);
   }
-  o << "]\n";
+  // the sherd list first, then only scalars: a reader cutting from the first '[' to the last ']'
+  // gets the list, one parsing the whole line gets px/cm too
+  o << "], \"sherd_count\": " << r.sherds.size() << ", \"px_per_cm\": ";
+  if (r.bar.found) {
+    o << r.bar.px_per_cm << ", \"scale\": \"" << r.bar.px_per_cm << " px/cm\"";
+  } else {
+    o << "null, \"scale\": \"no scale bar\"";
+  }
+  o << ", \"summary\": \"" << escape(summaryOf(r)) << "\"}\n";
   return o.str();
 }
 
