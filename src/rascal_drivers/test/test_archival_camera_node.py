@@ -1,6 +1,7 @@
-"""Wiring tests of archival_camera_driver (master on a free port). The OpenCV path is tested
-with a real OpenCV source, an image sequence (no camera is attached to the test machine); the
-gphoto2 path only for its error: libgphoto2 finds no DSLR here."""
+"""Tests of the archival camera: the OpenCV path with a real OpenCV source, an image sequence
+(no camera is attached to the test machine); the gphoto2 path against a DSLR emulated at
+python3-gphoto2's boundary (gphoto2_emulator; libgphoto2 itself finds no DSLR here), and the
+node (master on a free port)."""
 
 import json
 import os
@@ -83,79 +84,51 @@ def test_an_empty_or_undecodable_file_is_never_reported_as_an_image(tmp_path):
     assert not (tmp_path / "out.png").exists()
 
 
-class _Gphoto:
-    """python3-gphoto2's surface as GphotoCamera uses it, for a camera whose shutter speeds are
-    the usual third stops: records the shutter speed of every capture."""
+def _dslr(tmp_path, shoot=None):
+    """A DSLR emulated at python3-gphoto2's boundary whose source paints a grey frame (or runs
+    `shoot`), and GphotoCamera on it, set to 1/60 s at ISO 100."""
+    from rascal_drivers.archival_camera import GphotoCamera
+    from rascal_drivers.gphoto2_emulator import EmulatedGphoto2
 
-    GP_CAPTURE_IMAGE, GP_FILE_TYPE_NORMAL = 0, 1
-    SPEEDS = ["1/15", "1/20", "1/25", "1/30", "1/40", "1/50", "1/60", "1/80", "1/100", "1/125"]
-    SPEEDS += ["1/160", "1/200", "1/250"]
+    def grey(path, exposure_ev):
+        cv2.imwrite(path, np.full((30, 40, 3), 128, np.uint8))
 
-    class GPhoto2Error(Exception):
-        pass
-
-    def __init__(self, jpeg):
-        self.settings, self.shots, self.jpeg = {}, [], jpeg
-        gp = self
-
-        class Widget:
-            def __init__(self, name, choices):
-                self.name, self.choices = name, choices
-
-            def count_choices(self):
-                return len(self.choices)
-
-            def get_choice(self, i):
-                return self.choices[i]
-
-            def set_value(self, v):
-                gp.pending[self.name] = v
-
-        class Config:
-            def get_child_by_name(self, name):
-                choices = {"shutterspeed": gp.SPEEDS, "iso": ["100", "200"], "colortemperature": []}
-                return Widget(name, choices[name])
-
-        class File:
-            def save(self, path):
-                with open(path, "wb") as f:
-                    f.write(gp.jpeg)
-
-        class Where:
-            folder, name = "/store_00010001/DCIM", "IMG_0001.JPG"
-
-        class Camera:
-            def init(self):
-                pass
-
-            def get_config(self):
-                gp.pending = {}
-                return Config()
-
-            def set_config(self, _):
-                gp.settings.update(gp.pending)
-
-            def capture(self, _):
-                gp.shots.append(gp.settings["shutterspeed"])
-                return Where()
-
-            def file_get(self, *_):
-                return File()
-
-            def exit(self):
-                pass
-
-        self.Camera = Camera
+    gp = EmulatedGphoto2(cv2, shoot or grey, str(tmp_path / "card"), (1 / 60, 100))
+    cfg = read_section({"kind": "gphoto2", "exposure": 1 / 60, "iso": 100}, PREFIX)
+    return gp, GphotoCamera(gp, cv2, cfg)
 
 
 def test_a_dslr_shot_a_stop_darker_gets_half_the_shutter_time(tmp_path):
-    from rascal_drivers.archival_camera import GphotoCamera
-
-    _, jpeg = cv2.imencode(".jpg", np.full((30, 40, 3), 128, np.uint8))
-    gp = _Gphoto(jpeg.tobytes())
-    cfg = read_section({"kind": "gphoto2", "exposure": 1 / 60, "iso": 100}, PREFIX)
-    camera = GphotoCamera(gp, cv2, cfg)
+    gp, camera = _dslr(tmp_path)
     camera.open()
     for ev in (0.0, -1.0, -2.0, 0.0):
         assert camera.capture(str(tmp_path / "a.png"), ev) == (40, 30)
-    assert gp.shots == ["1/60", "1/125", "1/250", "1/60"]  # the nearest the camera offers
+    # the nearest third-stop speeds the camera offers, and the light they give the source
+    assert [shot[0] for shot in gp.shots] == ["1/60", "1/125", "1/250", "1/60"]
+    assert [round(shot[2], 2) for shot in gp.shots] == [0.0, -1.06, -2.06, 0.0]
+    assert len(os.listdir(tmp_path / "card")) == 4  # the JPEGs left on the card
+
+
+def test_dslr_faults_are_one_line_and_leave_no_file(tmp_path):
+    def refuses(path, exposure_ev):
+        raise RuntimeError("arm in view")
+
+    gp, camera = _dslr(tmp_path, refuses)
+    camera.open()
+    out = str(tmp_path / "a.png")
+    with pytest.raises(CaptureError, match=r"did not capture or download \(\[-7\] I/O problem"):
+        camera.capture(out)
+    assert not os.path.exists(out)
+    gp.plugged = False  # the camera switched off or its cable pulled mid-batch
+    gp.shoot = lambda path, ev: cv2.imwrite(path, np.zeros((3, 3, 3), np.uint8))
+    with pytest.raises(CaptureError, match=r"\[-7\] I/O problem") as e:
+        camera.capture(out)
+    assert "\n" not in str(e.value) and not os.path.exists(out)
+    camera.close()
+    with pytest.raises(CaptureError, match="no DSLR found by libgphoto2"):
+        camera.open()  # nothing on the bus
+    # a white balance the body does not offer is named by its key
+    gp.plugged = True
+    camera.config = dict(camera.config, white_balance=12000.0)
+    with pytest.raises(CaptureError, match="drivers.archival_camera.white_balance"):
+        camera.open()

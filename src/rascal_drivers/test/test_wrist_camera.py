@@ -107,3 +107,54 @@ def test_the_node_without_a_camera_exits_with_one_line(ros_master):
     assert res.returncode == 1
     lines = [ln for ln in res.stderr.strip().splitlines() if ln.strip()]
     assert len(lines) == 1 and "no RealSense D435 found" in lines[0], res.stderr
+
+
+def test_a_live_emulated_d435_gives_each_pushed_pair_through_the_sdk_with_its_stamp():
+    colour, depth = d435_emulator.mat_with_sherd()
+    # the simulator's images come aligned already: colour and depth share the sherd's pixels
+    depth = np.where(np.all(colour == d435_emulator.SHERD_RGB, axis=2), 390, 400).astype(np.uint16)
+    feed = d435_emulator.LiveD435(rs, 640, 480, 615.0, 615.0, 320.0, 240.0)
+    cfg = read_section({"source": "emulated:/emulated"}, "drivers.wrist_camera")
+    camera = RealSenseCamera(rs, cfg, feed)
+    camera.open()
+    got = []
+    for k in range(6):  # stamps as the simulator's: late in its time, unevenly spaced
+        feed.push(colour, depth, 40.0 + 0.5 * k * k)
+        if k >= 1:  # the syncer gives the very first frame of each stream alone
+            got.append(camera.frame(with_cloud=True))
+    camera.close()
+    assert [f.stamp for f in got] == [40.0 + 0.5 * k * k for k in range(1, 6)]
+    frame = got[-1]
+    assert np.array_equal(frame.colour, colour)
+    # the SDK's alignment (identity extrinsics): the same depths, but for its forward
+    # projection's holes (about 2 % of the pixels, 0 = no depth, as on a camera)
+    same = frame.depth_mm == depth
+    assert same.mean() > 0.95 and (same | (frame.depth_mm == 0)).all()
+    assert frame.depth_mm[SHERD_V, SHERD_U] == 390 and frame.depth_mm[SHERD_V, 40] == 400
+    k = SHERD_V * 640 + SHERD_U
+    valid = (frame.depth_mm.reshape(-1) > 0)[: k + 1].sum() - 1
+    assert frame.points[valid][2] == pytest.approx(0.390, abs=1e-4)
+    assert tuple(frame.point_colours[valid]) == d435_emulator.SHERD_RGB
+
+
+def test_a_live_emulated_d435_refuses_a_size_the_configuration_does_not_name():
+    feed = d435_emulator.LiveD435(rs, 424, 240, 307.0, 307.0, 212.0, 120.0)
+    camera = RealSenseCamera(
+        rs, read_section({"source": "emulated:/x"}, "drivers.wrist_camera"), feed
+    )
+    with pytest.raises(CameraError, match=r"drivers.wrist_camera.size: .* set it to \[424, 240\]"):
+        camera.open()
+    with pytest.raises(ValueError, match="emulated D435 depth: expected"):
+        feed.push(np.zeros((240, 424, 3), np.uint8), np.zeros((240, 424), np.float32), 1.0)
+    feed.close()
+
+
+def test_colour_and_depth_are_paired_by_their_stamp():
+    pairs = d435_emulator.StampPairs()
+    assert pairs.add("colour", "c1", 1.0) is None
+    assert pairs.add("colour", "c2", 2.0) is None  # depth of 1.0 still on its way
+    assert pairs.add("depth", "d1", 1.0) == ("c1", "d1", 1.0)
+    assert pairs.add("depth", "d2", 2.0) == ("c2", "d2", 2.0)
+    assert pairs.add("depth", "d9", 9.0) is None and pairs.add("colour", "c3", 3.0) is None
+    assert 3.0 not in pairs.waiting or 9.0 in pairs.waiting  # nothing older than 1 s is kept
+    assert pairs.add("colour", "c9", 9.0) == ("c9", "d9", 9.0) and pairs.waiting == {}

@@ -7,9 +7,12 @@ waits until each is healthy before the next, with a deadline per step:
 2. the configuration (`rosparam load`), the URDF as /robot_description, `check_config`, and the
    catalogue's tables (`rascal db migrate`);
 3. the field drivers (arm_driver, scale_driver, archival_camera_driver, wrist_camera_driver),
-   each healthy when its topic or service is up; or, with --emulated, the simulator (its arm and
-   scale topics under /emulated), the device emulators fed by it (emulated_devices), arm_driver
-   and scale_driver on the emulators' pseudo-terminals (the cameras stay the simulator's);
+   each healthy when its topic or service is up; or, with --emulated, the simulator (its device
+   topics and services under /emulated), the device emulators fed by it (emulated_devices: the
+   servo bus and the scale on pseudo-terminals), and the same four drivers: arm_driver and
+   scale_driver on the pseudo-terminals, wrist_camera_driver on librealsense's software device
+   fed with the simulator's wrist images, archival_camera_driver on a DSLR emulated at
+   python3-gphoto2's boundary whose pictures the simulator takes;
 4. arm_controller and sherd_detector.
 
 Then it runs COMMAND (and stops the rig when it ends, with its exit code), or waits for Ctrl-C.
@@ -41,6 +44,13 @@ SIM_REMAPS = (
     "/gripper/command:=%s/gripper/command" % SIM_NS,
     "/scale/mass:=%s/scale/mass" % SIM_NS,
     "/scale/tare:=%s/scale/tare" % SIM_NS,
+    "/archival_camera/capture:=%s/archival_camera/capture" % SIM_NS,
+    "/camera/color/image_raw:=%s/camera/color/image_raw" % SIM_NS,
+    "/camera/color/camera_info:=%s/camera/color/camera_info" % SIM_NS,
+    "/camera/aligned_depth_to_color/image_raw:=%s/camera/aligned_depth_to_color/image_raw" % SIM_NS,
+    "/camera/aligned_depth_to_color/camera_info:=%s/camera/aligned_depth_to_color/camera_info"
+    % SIM_NS,
+    "/camera/depth/color/points:=%s/camera/depth/color/points" % SIM_NS,
 )
 
 
@@ -123,6 +133,18 @@ def emulated_nodes(links: Sequence[str]) -> List[Node]:
             ["rosrun", "rascal_drivers", "scale_driver"],
             ("service", "/scale/tare"),
             15.0,
+        ),
+        Node(
+            "archival_camera_driver",
+            ["rosrun", "rascal_drivers", "archival_camera_driver"],
+            ("service", "/archival_camera/capture"),
+            45.0,
+        ),
+        Node(
+            "wrist_camera_driver",
+            ["rosrun", "rascal_drivers", "wrist_camera_driver"],
+            ("topic", "/camera/color/image_raw"),
+            45.0,
         ),
     ]
 
@@ -259,6 +281,12 @@ class Rig:
             params.setdefault("/drivers/arm/bus_timeout", "1.0")
             params["/drivers/arm/device"] = self.links[0]
             params["/drivers/scale/device"] = self.links[1]
+            params["/drivers/wrist_camera/source"] = "emulated:" + SIM_NS
+            params["/drivers/archival_camera/kind"] = "gphoto2"
+            params["/drivers/archival_camera/device"] = "emulated:" + SIM_NS
+            # the simulator at a quarter speed on a busy machine may pause its frames for a
+            # second or two of wall time; a camera that long silent on the rig is unplugged
+            params.setdefault("/drivers/wrist_camera/frame_timeout", "10.0")
         for key, value in params.items():
             self._run(["rosparam", "set", key, value], "rosparam set %s" % key)
         self._run(["rosrun", "rascal_tasks", "check_config"], "check_config")

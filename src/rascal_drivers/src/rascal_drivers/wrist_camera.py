@@ -2,11 +2,14 @@
 SDK's own rs.align, the colour stream's intrinsics, and a point cloud from the SDK's own
 deprojection (rs.pointcloud), as the simulator gives them to perception.
 
-The source is a live D435 (`usb`, picked by serial number) or a recording the SDK plays back
+The source is a live D435 (`usb`, picked by serial number), a recording the SDK plays back
 through the same pipeline (a file written by rs.recorder: the tests' emulated D435, or a
-session recorded on the rig). No ROS here; pyrealsense2 is injected by the node.
+session recorded on the rig), or an emulated D435 fed live (`emulated:NS`, d435_emulator's
+LiveD435: the SDK's software device, fed by the node with the simulator's images). No ROS here;
+pyrealsense2 and the live feed are injected by the node.
 """
 
+import time
 from dataclasses import dataclass
 from typing import Optional
 
@@ -32,12 +35,16 @@ class Intrinsics:
 
 @dataclass
 class WristFrame:
-    stamp: float  # [s] the SDK's frame timestamp (ms in librealsense) in seconds
+    stamp: float  # [s] the SDK's frame timestamp (ms in librealsense) in seconds; live
+    # emulated: the stamp of the simulator's image
     colour: np.ndarray  # (H, W, 3) uint8 RGB
     depth_mm: np.ndarray  # (H, W) uint16, depth in mm aligned to colour, 0 = none
     intrinsics: Intrinsics  # of the colour stream (the aligned depth shares them)
     points: Optional[np.ndarray] = None  # (N, 3) float32 in the colour optical frame [m]
     point_colours: Optional[np.ndarray] = None  # (N, 3) uint8 RGB
+
+
+EMULATED = "emulated:"  # source prefix: the simulator's camera topics under the namespace after it
 
 
 def check_config(config: dict) -> None:
@@ -49,9 +56,10 @@ def check_config(config: dict) -> None:
 
 
 class RealSenseCamera:
-    def __init__(self, rs, config: dict):
+    def __init__(self, rs, config: dict, feed=None):
         self.rs = rs
         self.config = config
+        self.feed = feed  # a LiveD435 for source emulated:NS
         self.pipeline = None
         self.align = rs.align(rs.stream.color)
         self.cloud = rs.pointcloud()
@@ -60,8 +68,24 @@ class RealSenseCamera:
     def open(self) -> None:
         rs, c = self.rs, self.config
         width, height = (int(v) for v in c["size"])
-        cfg = rs.config()
         source = c["source"]
+        if source.startswith(EMULATED):
+            if (self.feed.width, self.feed.height) != (width, height):
+                raise CameraError(
+                    "drivers.wrist_camera.size: the emulated camera gives %d x %d, not %d x %d; "
+                    "set it to [%d, %d]"
+                    % (
+                        self.feed.width,
+                        self.feed.height,
+                        width,
+                        height,
+                        self.feed.width,
+                        self.feed.height,
+                    )
+                )
+            self.depth_scale_mm = self.feed.depth_units * 1000.0
+            return
+        cfg = rs.config()
         if source != "usb":
             cfg.enable_device_from_file(source, True)  # repeat: a recording stands in for a camera
         elif c["serial"] != "any":
@@ -93,14 +117,31 @@ class RealSenseCamera:
         units = depth_sensor.get_option(rs.option.depth_units)  # [m] per depth count
         self.depth_scale_mm = units * 1000.0
 
+    def _frameset(self):
+        """The next frameset with both colour and depth (the syncer gives the very first frame
+        of each stream alone)."""
+        timeout = self.config["frame_timeout"]
+        source = self.feed if self.feed is not None else self.pipeline
+        end = time.monotonic() + timeout
+        while True:
+            left_ms = max(1, int((end - time.monotonic()) * 1000))
+            try:
+                frames = source.wait_for_frames(left_ms)
+            except RuntimeError as e:
+                raise CameraError(
+                    "no frames from the wrist camera for %.1f s (drivers.wrist_camera."
+                    "frame_timeout; %s); check its USB cable" % (timeout, e)
+                ) from e
+            if frames.get_color_frame() and frames.get_depth_frame():
+                return frames
+            if time.monotonic() > end:
+                raise CameraError(
+                    "the wrist camera delivered no frame set with both colour and depth for "
+                    "%.1f s (drivers.wrist_camera.frame_timeout)" % timeout
+                )
+
     def frame(self, with_cloud: bool) -> WristFrame:
-        try:
-            frames = self.pipeline.wait_for_frames(int(self.config["frame_timeout"] * 1000))
-        except RuntimeError as e:
-            raise CameraError(
-                "no frames from the wrist camera for %.1f s (drivers.wrist_camera.frame_timeout; "
-                "%s); check its USB cable" % (self.config["frame_timeout"], e)
-            ) from e
+        frames = self._frameset()
         aligned = self.align.process(frames)
         colour_frame = aligned.get_color_frame()
         depth_frame = aligned.get_depth_frame()
@@ -113,8 +154,11 @@ class RealSenseCamera:
         else:
             depth_mm = np.clip(np.rint(raw * self.depth_scale_mm), 0, 65535).astype(np.uint16)
         i = colour_frame.profile.as_video_stream_profile().intrinsics
+        stamp = colour_frame.get_timestamp() / 1000.0
+        if self.feed is not None:
+            stamp = self.feed.stamp_of(colour_frame.get_frame_number())
         out = WristFrame(
-            stamp=colour_frame.get_timestamp() / 1000.0,
+            stamp=stamp,
             colour=colour,
             depth_mm=depth_mm,
             intrinsics=Intrinsics(i.width, i.height, i.fx, i.fy, i.ppx, i.ppy, list(i.coeffs)),
@@ -129,6 +173,8 @@ class RealSenseCamera:
         return out
 
     def close(self) -> None:
+        if self.feed is not None:
+            self.feed.close()
         if self.pipeline is not None:
             try:
                 self.pipeline.stop()
