@@ -198,3 +198,21 @@ def test_the_scale_in_the_wrong_protocol_silent_or_unsteady(tmp_path, monkeypatc
         assert "draught shield" in unsteady.fix
     finally:
         scale.stop()
+
+
+def test_cameras_left_on_the_emulated_rig_are_a_warning_with_the_fix(tmp_path):
+    config = site_config(
+        tmp_path,
+        {
+            "archival_camera": {"kind": "gphoto2", "device": "emulated:/emulated"},
+            "wrist_camera": {"source": "emulated:/emulated"},
+        },
+    )
+    for device, fix in (
+        ("archival_camera", "drivers.archival_camera.device back to /dev/video0"),
+        ("wrist_camera", "drivers.wrist_camera.source: usb"),
+    ):
+        res = doctor_cli(config, "--device", device)
+        line = res.stdout.strip().splitlines()[0]
+        assert line.startswith("warn") and "emulated (emulated:/emulated" in line, line
+        assert fix in line, line

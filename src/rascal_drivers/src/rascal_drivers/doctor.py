@@ -340,6 +340,15 @@ def check_archival_camera(section: dict, cv2=None, gp=None) -> List[Item]:
         else:
             add("USB camera", OK, "%s answers, %dx%d px" % (device, image.shape[1], image.shape[0]))
         return items
+    if section["device"].startswith("emulated:"):
+        add(
+            "DSLR",
+            WARN,
+            "emulated (%s: the simulator takes the pictures)" % section["device"],
+            "on the rig, set drivers.archival_camera.device back to /dev/video0 (rig --emulated "
+            "sets it itself)",
+        )
+        return items
     try:
         gp = gp or _import("gphoto2")
     except ImportError:
@@ -380,8 +389,16 @@ def check_wrist_camera(section: dict, rs=None) -> List[Item]:
     except ValueError as e:
         add("configuration", FAIL, str(e), "correct it in config/rascal.yaml")
         return items
-    rs = rs or _import("pyrealsense2")
     source = section["source"]
+    if source.startswith("emulated:"):
+        add(
+            "D435",
+            WARN,
+            "emulated (%s: the simulator's images through librealsense's software device)" % source,
+            "on the rig, set drivers.wrist_camera.source: usb (rig --emulated sets it itself)",
+        )
+        return items
+    rs = rs or _import("pyrealsense2")
     if source == "usb":
         devices = list(rs.context().query_devices())
         if not devices:
