@@ -158,3 +158,18 @@ def test_colour_and_depth_are_paired_by_their_stamp():
     assert pairs.add("depth", "d9", 9.0) is None and pairs.add("colour", "c3", 3.0) is None
     assert 3.0 not in pairs.waiting or 9.0 in pairs.waiting  # nothing older than 1 s is kept
     assert pairs.add("colour", "c9", 9.0) == ("c9", "d9", 9.0) and pairs.waiting == {}
+
+
+def test_a_live_emulated_d435_whose_frames_stop_is_named_in_one_line():
+    """The simulator stopped (or the camera unplugged): no frame set within frame_timeout."""
+    feed = d435_emulator.LiveD435(rs, 640, 480, 615.0, 615.0, 320.0, 240.0)
+    cfg = read_section({"source": "emulated:/e", "frame_timeout": 0.3}, "drivers.wrist_camera")
+    camera = RealSenseCamera(rs, cfg, feed)
+    camera.open()
+    colour, depth = d435_emulator.mat_with_sherd()
+    feed.push(colour, depth, 1.0)  # only the first pair, which the syncer gives apart
+    with pytest.raises(CameraError, match="drivers.wrist_camera.frame_timeout") as e:
+        for _ in range(3):
+            camera.frame(with_cloud=False)
+    assert "\n" not in str(e.value)
+    camera.close()
