@@ -9,7 +9,6 @@
 
 import os
 import subprocess
-import uuid
 
 import pytest
 
@@ -72,19 +71,8 @@ def rosrun(ros_master):
 @pytest.fixture
 def pg_dsn():
     """A fresh, empty database for one test; dropped afterwards."""
-    psycopg2 = pytest.importorskip("psycopg2")
-    name = "rascal_test_" + uuid.uuid4().hex[:12]
-    admin = psycopg2.connect(PG_ADMIN_DSN)
-    admin.autocommit = True
-    with admin.cursor() as cur:
-        cur.execute("CREATE DATABASE " + name)  # name is generated above, never user input
-    dsn = PG_ADMIN_DSN.rsplit("/", 1)[0] + "/" + name
-    yield dsn
-    with admin.cursor() as cur:
-        cur.execute(
-            "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
-            " AND backend_type = 'client backend'",
-            (name,),
-        )
-        cur.execute("DROP DATABASE IF EXISTS " + name)
-    admin.close()
+    pytest.importorskip("psycopg2")
+    from rascal_tasks.catalogue.scratch import scratch_database
+
+    with scratch_database(PG_ADMIN_DSN) as dsn:
+        yield dsn

@@ -4,10 +4,11 @@ with any connection still open to it. Imported by the bench scripts beside it.""
 
 import contextlib
 import os
-import uuid
 
 import psycopg2
 import psycopg2.extras
+
+from rascal_tasks.catalogue import scratch
 
 ADMIN = os.environ.get("RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0.1:5432/rascal")
 
@@ -15,21 +16,8 @@ ADMIN = os.environ.get("RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0
 @contextlib.contextmanager
 def scratch_database():
     """Yields the DSN of a new, empty database; drops it on the way out."""
-    name = "rascal_bench_" + uuid.uuid4().hex[:8]
-    admin = psycopg2.connect(ADMIN)
-    admin.autocommit = True
-    admin.cursor().execute("CREATE DATABASE " + name)
-    try:
-        yield ADMIN.rsplit("/", 1)[0] + "/" + name
-    finally:
-        with admin.cursor() as cur:
-            cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
-                " AND backend_type = 'client backend'",
-                (name,),
-            )
-            cur.execute("DROP DATABASE IF EXISTS " + name)
-        admin.close()
+    with scratch.scratch_database(ADMIN, "rascal_bench_") as dsn:
+        yield dsn
 
 
 def sherd_rows(dsn):

@@ -8,7 +8,6 @@ import json
 import os
 import re
 import tarfile
-import uuid
 
 import psycopg2
 import pytest
@@ -16,6 +15,7 @@ from test_catalogue_verbs import fill_catalogue, one_error_line, query, rascal
 
 from rascal_tasks.catalogue import Catalogue, ImageArchive, available, verify_archive
 from rascal_tasks.catalogue.backup import find_pg_tool, tool_connection
+from rascal_tasks.catalogue.scratch import create_database, drop_database, dsn_of
 
 pytestmark = pytest.mark.timeout(180)
 
@@ -31,20 +31,12 @@ def empty_db():
     names = []
 
     def make():
-        names.append("rascal_test_" + uuid.uuid4().hex[:12])
-        with admin.cursor() as cur:
-            cur.execute("CREATE DATABASE " + names[-1])  # generated name, never user input
-        return ADMIN_DSN.rsplit("/", 1)[0] + "/" + names[-1]
+        names.append(create_database(admin))
+        return dsn_of(ADMIN_DSN, names[-1])
 
     yield make
-    with admin.cursor() as cur:
-        for name in names:
-            cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
-                " AND backend_type = 'client backend'",
-                (name,),
-            )
-            cur.execute("DROP DATABASE IF EXISTS " + name)
+    for name in names:
+        drop_database(admin, name)
     admin.close()
 
 

@@ -5,7 +5,6 @@ import datetime
 import json
 import os
 import subprocess
-import uuid
 import zoneinfo
 
 import psycopg2
@@ -15,6 +14,7 @@ from catalogue_helpers import PYTHON, FakeClock, subprocess_env
 from rascal_tasks.catalogue import Catalogue, ImageArchive, verify_archive
 from rascal_tasks.catalogue.audit import edit_sherd, parse_assignment
 from rascal_tasks.catalogue.errors import FieldError
+from rascal_tasks.catalogue.scratch import scratch_database
 from rascal_tasks.catalogue.queries import (
     contexts_summary,
     parse_find_id,
@@ -105,27 +105,12 @@ def unchanged(tmp_path_factory):
     admin_dsn = os.environ.get(
         "RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0.1:5432/rascal"
     )
-    name = "rascal_test_" + uuid.uuid4().hex[:12]
-    admin = psycopg2.connect(admin_dsn)
-    admin.autocommit = True
-    with admin.cursor() as cur:
-        cur.execute("CREATE DATABASE " + name)  # generated name, never user input
-    dsn = admin_dsn.rsplit("/", 1)[0] + "/" + name
-    try:
+    with scratch_database(admin_dsn) as dsn:
         conn = psycopg2.connect(dsn)
         migrate(conn)
         conn.close()
         archive = tmp_path_factory.mktemp("unchanged") / "archive"
         yield dsn, str(archive), fill_catalogue(dsn, archive)
-    finally:
-        with admin.cursor() as cur:
-            cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
-                " AND backend_type = 'client backend'",
-                (name,),
-            )
-            cur.execute("DROP DATABASE IF EXISTS " + name)
-        admin.close()
 
 
 def local(ts):

@@ -20,7 +20,6 @@ import subprocess
 import threading
 import time
 import urllib.parse
-import uuid
 
 import psycopg2
 import psycopg2.extensions
@@ -40,6 +39,7 @@ from rascal_tasks.catalogue import (
     wait_for_database,
 )
 from rascal_tasks.catalogue.archive import owner_tag, sidecar_relpath
+from rascal_tasks.catalogue.scratch import scratch_database
 from rascal_tasks.recorder import Recorder
 
 pytestmark = [pytest.mark.faults, pytest.mark.timeout(120)]
@@ -79,26 +79,11 @@ def sherd_row(dsn, sherd_id):
 @contextlib.contextmanager
 def fresh_database():
     """A second throw-away, migrated database (the root conftest's `pg_dsn` gives one)."""
-    name = "rascal_test_" + uuid.uuid4().hex[:12]
-    admin = psycopg2.connect(ADMIN_DSN)
-    admin.autocommit = True
-    with admin.cursor() as cur:
-        cur.execute("CREATE DATABASE " + name)  # generated name, never user input
-    dsn = ADMIN_DSN.rsplit("/", 1)[0] + "/" + name
-    try:
+    with scratch_database(ADMIN_DSN) as dsn:
         conn = psycopg2.connect(dsn)
         migrate(conn)
         conn.close()
         yield dsn
-    finally:
-        with admin.cursor() as cur:
-            cur.execute(
-                "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s"
-                " AND backend_type = 'client backend'",
-                (name,),
-            )
-            cur.execute("DROP DATABASE IF EXISTS " + name)
-        admin.close()
 
 
 class TcpProxy:
