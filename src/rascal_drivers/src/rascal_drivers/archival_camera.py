@@ -113,7 +113,8 @@ def _nearest_choice(widget, value: float, parse) -> str:
     return min(scored)[1]
 
 
-def _shutter_seconds(text: str) -> float:
+def shutter_seconds(text: str) -> float:
+    """A shutter-speed choice ('1/125', '0.5', '2s') in seconds."""
     text = text.strip().rstrip("s")
     if "/" in text:
         num, den = text.split("/", 1)
@@ -151,7 +152,7 @@ class GphotoCamera:
         config = self.camera.get_config()
         shutter = c["exposure"] * 2.0**exposure_ev  # the nearest the camera offers
         settings = (
-            ("shutterspeed", "drivers.archival_camera.exposure", shutter, _shutter_seconds),
+            ("shutterspeed", "drivers.archival_camera.exposure", shutter, shutter_seconds),
             ("iso", "drivers.archival_camera.iso", c["iso"], float),
         )
         for name, key, value, parse in settings:

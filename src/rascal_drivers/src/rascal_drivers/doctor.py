@@ -18,6 +18,7 @@ from typing import Callable, Dict, List, Optional
 
 from rascal_drivers import control_table as ct
 from rascal_drivers import workspace_venv
+from rascal_drivers.parameters import EMULATED
 
 OK, WARN, FAIL = "ok", "warn", "FAIL"
 MODEL_NAMES = {ct.XM430_W350: "XM430-W350", ct.XL430_W250: "XL430-W250"}
@@ -340,7 +341,7 @@ def check_archival_camera(section: dict, cv2=None, gp=None) -> List[Item]:
         else:
             add("USB camera", OK, "%s answers, %dx%d px" % (device, image.shape[1], image.shape[0]))
         return items
-    if section["device"].startswith("emulated:"):
+    if section["device"].startswith(EMULATED):
         add(
             "DSLR",
             WARN,
@@ -390,7 +391,7 @@ def check_wrist_camera(section: dict, rs=None) -> List[Item]:
         add("configuration", FAIL, str(e), "correct it in config/rascal.yaml")
         return items
     source = section["source"]
-    if source.startswith("emulated:"):
+    if source.startswith(EMULATED):
         add(
             "D435",
             WARN,

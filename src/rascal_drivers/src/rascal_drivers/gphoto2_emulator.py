@@ -15,6 +15,8 @@ import math
 import os
 from typing import Callable
 
+from rascal_drivers.archival_camera import shutter_seconds
+
 # libgphoto2's result codes and texts (gphoto2-result.h, gphoto2-port-result.h)
 GP_ERROR = -1
 GP_ERROR_BAD_PARAMETERS = -2
@@ -47,13 +49,6 @@ class GPhoto2Error(Exception):
         self.code = code
         text = "[%d] %s" % (code, MESSAGES.get(code, "Unspecified error"))
         super().__init__(text + (" (%s)" % detail if detail else ""))
-
-
-def shutter_seconds(text: str) -> float:
-    if "/" in text:
-        num, den = text.split("/", 1)
-        return float(num) / float(den)
-    return float(text)
 
 
 class _Widget:

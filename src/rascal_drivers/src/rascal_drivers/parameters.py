@@ -10,6 +10,10 @@ from typing import Optional
 
 from rascal_workcell import schema
 
+# A camera's source/device `emulated:NS`: the simulator's camera under namespace NS stands in
+# for the device (rig --emulated sets it)
+EMULATED = "emulated:"
+
 
 def read_section(data: Optional[dict], prefix: str) -> dict:
     """The section checked and with its defaults; raises schema.SchemaError naming the key.

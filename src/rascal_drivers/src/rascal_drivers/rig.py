@@ -34,6 +34,7 @@ import xmlrpc.client
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
+from rascal_drivers.parameters import EMULATED
 from rascal_workcell.processes import free_port, stop, workspace
 
 FAULT = 3
@@ -281,9 +282,9 @@ class Rig:
             params.setdefault("/drivers/arm/bus_timeout", "1.0")
             params["/drivers/arm/device"] = self.links[0]
             params["/drivers/scale/device"] = self.links[1]
-            params["/drivers/wrist_camera/source"] = "emulated:" + SIM_NS
+            params["/drivers/wrist_camera/source"] = EMULATED + SIM_NS
             params["/drivers/archival_camera/kind"] = "gphoto2"
-            params["/drivers/archival_camera/device"] = "emulated:" + SIM_NS
+            params["/drivers/archival_camera/device"] = EMULATED + SIM_NS
             # the simulator at a quarter speed on a busy machine may pause its frames for a
             # second or two of wall time; a camera that long silent on the rig is unplugged
             params.setdefault("/drivers/wrist_camera/frame_timeout", "10.0")

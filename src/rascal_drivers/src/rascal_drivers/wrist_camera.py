@@ -15,6 +15,8 @@ from typing import Optional
 
 import numpy as np
 
+from rascal_drivers.parameters import EMULATED
+
 FRAME_RATES = (6, 15, 30, 60)  # colour + depth modes both D435 streams offer (Intel)
 
 
@@ -42,9 +44,6 @@ class WristFrame:
     intrinsics: Intrinsics  # of the colour stream (the aligned depth shares them)
     points: Optional[np.ndarray] = None  # (N, 3) float32 in the colour optical frame [m]
     point_colours: Optional[np.ndarray] = None  # (N, 3) uint8 RGB
-
-
-EMULATED = "emulated:"  # source prefix: the simulator's camera topics under the namespace after it
 
 
 def check_config(config: dict) -> None:
