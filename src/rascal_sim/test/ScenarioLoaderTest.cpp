@@ -105,6 +105,33 @@ TEST(ScenarioLoader, ErrorsNameTheKey) {
   }
 }
 
+TEST(ScenarioLoader, StationOffsetsAreReadAndABadOneIsNamed) {
+  Fixture f;
+  ScenarioLoader loader(f.layout, f.munsell);
+  const std::string pickup = f.layout.station(StationType::Pickup).name;
+  const Scenario s = loader.parse("station_offsets: {" + pickup + ": [0.02, -0.015, 0.06]}\n"
+                                  "generate: {count: 6, station: pickup}\n");
+  ASSERT_EQ(s.station_offsets.size(), 1u);
+  EXPECT_EQ(s.station_offsets.at(pickup), (StationOffset{0.02, -0.015, 0.06}));
+  TableRect mat = f.layout.station(StationType::Pickup).area;
+  mat.centre += Eigen::Vector2d(0.02, -0.015);
+  for (const SherdSpec& sp : s.sherds) EXPECT_TRUE(mat.contains(sp.pose.head<2>())) << sp.name;  // on the moved mat
+  EXPECT_TRUE(loader.parse("name: t\n").station_offsets.empty());
+  const std::vector<std::string> bad_ones{pickup + ": [0.2, 0, 0]", pickup + ": [0, 0, -0.3]",
+                                          pickup + ": [0, 0]", "nowhere: [0, 0, 0]"};
+  for (const std::string& bad : bad_ones) {
+    const std::string key = "station_offsets." + bad.substr(0, bad.find(':'));
+    try {
+      loader.parse("station_offsets: {" + bad + "}\n");
+      FAIL() << bad << " accepted";
+    } catch (const std::runtime_error& e) {
+      const std::string why = e.what();
+      EXPECT_EQ(why.rfind("scenario key '" + key + "': ", 0), 0u) << why;
+      EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+    }
+  }
+}
+
 TEST(ScenarioLoader, RealismIsOffUnlessAskedForAndAKeyLeftOutTakesItsDefault) {
   Fixture f;
   ScenarioLoader loader(f.layout, f.munsell);

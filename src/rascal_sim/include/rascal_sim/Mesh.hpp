@@ -21,6 +21,9 @@ struct Mesh {
   void addBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size, const Eigen::Vector3d& srgb);
   /// Adds a flat rectangle at height z (centre x, y; size x, y) with one sRGB colour.
   void addRect(double cx, double cy, double sx, double sy, double z, const Eigen::Vector3d& srgb);
+  /// Adds a flat quadrilateral a, b, c, d (counter-clockwise seen from its front) with one sRGB colour.
+  void addQuad(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+               const Eigen::Vector3d& d, const Eigen::Vector3d& srgb);
   /// Signed volume enclosed by a closed mesh [m^3] (absolute value returned).
   double volume() const;
   Eigen::Vector3d minCorner() const;

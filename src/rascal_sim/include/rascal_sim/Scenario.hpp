@@ -1,6 +1,8 @@
 #pragma once
-// A scenario: the sherds on the table and the lighting, read from a YAML file.
+// A scenario: the sherds on the table, the lighting and where the stations really stand, read
+// from a YAML file.
 #include <Eigen/Geometry>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -45,11 +47,23 @@ struct Lighting {
   Realism realism;
 };
 
+/// Where a station really stands against the configuration (the rig set up off its measured
+/// layout): what the marker calibration must find.
+struct StationOffset {
+  static constexpr double kMaxShift = 0.1;  ///< [m] |dx|, |dy|
+  static constexpr double kMaxTurn = 0.2;   ///< [rad] |dyaw|
+  double dx = 0.0, dy = 0.0;  ///< [m] in base_link
+  double dyaw = 0.0;          ///< [rad] about the station's centre (only its markers show it)
+  bool operator==(const StationOffset& o) const { return dx == o.dx && dy == o.dy && dyaw == o.dyaw; }
+  bool operator!=(const StationOffset& o) const { return !(*this == o); }
+};
+
 struct Scenario {
   std::string name = "empty";
   unsigned seed = 1;
   Lighting lighting;
   std::vector<SherdSpec> sherds;
+  std::map<std::string, StationOffset> station_offsets;  ///< by station name; none = as configured
 };
 
 }  // namespace rascal_sim

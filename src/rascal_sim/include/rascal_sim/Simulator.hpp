@@ -1,6 +1,7 @@
 #pragma once
 // Everything the node drives: world physics, servos, gripper and grasp logic, scale, wrist and
 // archival cameras, faults and sim time. No ROS communication.
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -59,12 +60,15 @@ class Simulator {
 
   /// Throws std::invalid_argument when options.gripper is not set or initial_finger is outside it.
   Simulator(const WorldLayout& layout, const SimulatorOptions& options);
-  /// Spawns the scenario's sherds and takes its lighting; remembered for reset().
+  /// Spawns the scenario's sherds and takes its lighting; remembered for reset(). A scenario whose
+  /// station_offsets differ from the last one's rebuilds the world with the stations where it
+  /// has them (the clock runs on; refused with std::runtime_error during an archival capture,
+  /// std::invalid_argument naming an unknown station).
   void load(const Scenario& scenario);
   /// Re-spawns the last scenario and puts the arm back at its initial pose (time runs on).
   void reset();
   void step();
-  double time() const { return world_.time(); }
+  double time() const { return world_->time(); }
 
   void commandArm(double start_time, const std::vector<TrajectoryPoint>& points,
                   const std::array<bool, kArmJoints>& mask);
@@ -105,20 +109,23 @@ class Simulator {
 
   bool injectFault(int fault, double duration, std::string& message);
   std::vector<SherdState> groundTruth() const;
-  World& world() { return world_; }
+  World& world() { return *world_; }
   const Scenario& scenario() const { return scenario_; }
   const SimulatorOptions& options() const { return options_; }
 
  private:
+  /// The world (and the archival camera on its stand) rebuilt with the configured stations moved
+  /// by `offsets`.
+  void moveStations(const std::map<std::string, StationOffset>& offsets);
   void updateGrasp();
   /// A close is under way and a sherd is held or pressed by both fingers.
   bool squeezing() const;
   /// Lets the held sherd go because the fingers open: it falls out of them under physics.
   void releaseByOpening();
 
-  WorldLayout layout_;
+  WorldLayout layout_;  ///< as configured; the world has the stations where they really stand
   SimulatorOptions options_;
-  World world_;
+  std::unique_ptr<World> world_;  ///< rebuilt when a scenario moves the stations
   ServoModel servos_;
   GripperModel gripper_;
   ScaleSensor scale_;

@@ -39,9 +39,10 @@ struct FingerContacts {
 
 class World {
  public:
-  /// Static fixtures from layout.workcell.collisionBoxes(); the arm starts at the sleep pose with
-  /// the fingers fully open (gripper.finger_max).
-  World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& gripper);
+  /// Static fixtures from layout.boxes (where the stations really stand); the arm starts at the
+  /// sleep pose with the fingers fully open (gripper.finger_max). The clock starts at start_time
+  /// (a world rebuilt for a scenario that moves the stations carries the simulator's time on).
+  World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& gripper, double start_time = 0.0);
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;

@@ -43,11 +43,14 @@ void Mesh::addBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size,
 
 void Mesh::addRect(double cx, double cy, double sx, double sy, double z,
                    const Eigen::Vector3d& srgb) {
+  addQuad({cx - sx / 2, cy - sy / 2, z}, {cx + sx / 2, cy - sy / 2, z}, {cx + sx / 2, cy + sy / 2, z},
+          {cx - sx / 2, cy + sy / 2, z}, srgb);
+}
+
+void Mesh::addQuad(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                   const Eigen::Vector3d& d, const Eigen::Vector3d& srgb) {
   const int base = static_cast<int>(vertices.size());
-  vertices.emplace_back(cx - sx / 2, cy - sy / 2, z);
-  vertices.emplace_back(cx + sx / 2, cy - sy / 2, z);
-  vertices.emplace_back(cx + sx / 2, cy + sy / 2, z);
-  vertices.emplace_back(cx - sx / 2, cy + sy / 2, z);
+  vertices.insert(vertices.end(), {a, b, c, d});
   const Eigen::Vector3f lin = srgbToLinear(srgb);
   addTriangle(base, base + 1, base + 2, lin);
   addTriangle(base, base + 2, base + 3, lin);

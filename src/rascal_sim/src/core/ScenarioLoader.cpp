@@ -46,15 +46,47 @@ std::vector<double> numbers(const YAML::Node& node, const std::string& key, size
   return v;
 }
 
-/// A station by its type (`camera` is the archival camera's), never by the site's name for it.
-TableRect station(const WorldLayout& l, const std::string& type, const std::string& key) {
+/// A station's area by its type (`camera` is the archival camera's), never by the site's name
+/// for it, where the scenario has it really stand.
+TableRect station(const WorldLayout& l, const std::map<std::string, StationOffset>& offsets,
+                  const std::string& type, const std::string& key) {
   StationType t = StationType::Pickup;
   try {
     t = rascal_workcell::stationTypeFromString(type == "camera" ? "archival_camera" : type);
   } catch (const std::invalid_argument&) {
     fail(key, "unknown station type '" + type + "' (pickup, scale, camera, discard)");
   }
-  return l.station(t).area;
+  const Station& s = l.station(t);
+  TableRect area = s.area;
+  const auto o = offsets.find(s.name);
+  if (o != offsets.end()) area.centre += Eigen::Vector2d(o->second.dx, o->second.dy);
+  return area;
+}
+
+/// `station_offsets`: station name -> [dx, dy, dyaw], each within StationOffset's limits.
+std::map<std::string, StationOffset> stationOffsets(const YAML::Node& node, const WorldLayout& l) {
+  std::map<std::string, StationOffset> offsets;
+  if (!node) return offsets;
+  if (!node.IsMap()) fail("station_offsets", "expected a mapping of station name to [dx, dy, dyaw]");
+  for (const auto& kv : node) {
+    const std::string name = kv.first.as<std::string>();
+    const std::string key = "station_offsets." + name;
+    if (!l.find(name)) {
+      std::string known;
+      for (const Station& s : l.stations) known += (known.empty() ? "" : ", ") + s.name;
+      fail(key, "no such station (" + known + ")");
+    }
+    const auto v = numbers(kv.second, key, 3);
+    if (std::abs(v[0]) > StationOffset::kMaxShift || std::abs(v[1]) > StationOffset::kMaxShift ||
+        std::abs(v[2]) > StationOffset::kMaxTurn) {
+      std::ostringstream ss;
+      ss << "[dx, dy, dyaw] = [" << v[0] << ", " << v[1] << ", " << v[2] << "] outside ±" << StationOffset::kMaxShift
+         << " m, ±" << StationOffset::kMaxShift << " m, ±" << StationOffset::kMaxTurn << " rad";
+      fail(key, ss.str());
+    }
+    offsets[name] = {v[0], v[1], v[2]};
+  }
+  return offsets;
 }
 }  // namespace
 
@@ -110,13 +142,14 @@ Scenario ScenarioLoader::parse(const std::string& yaml_text) const {
       }
     }
   }
+  s.station_offsets = stationOffsets(root["station_offsets"], layout_);
   const std::string fragment = layout_.data_dir + "/archaide_braccio_frag_1.stl";
   const YAML::Node gen = root["generate"];
   if (gen) {
     GeneratorOptions o;
     o.count = static_cast<int>(number(gen["count"], "generate.count", 10, 0, 200));
     o.seed = static_cast<unsigned>(number(gen["seed"], "generate.seed", s.seed, 0, 4e9));
-    o.area = station(layout_, gen["station"] ? gen["station"].as<std::string>() : "pickup",
+    o.area = station(layout_, s.station_offsets, gen["station"] ? gen["station"].as<std::string>() : "pickup",
                      "generate.station");
     o.min_spacing = number(gen["min_spacing"], "generate.min_spacing", o.min_spacing, 0.0, 0.1);
     o.touching_pairs = static_cast<int>(number(gen["touching_pairs"], "generate.touching_pairs", 0, 0, 100));

@@ -31,20 +31,21 @@ const SimulatorOptions& checked(const SimulatorOptions& o) {
 Simulator::Simulator(const WorldLayout& layout, const SimulatorOptions& options)
     : layout_(layout),
       options_(checked(options)),
-      world_(layout, options.gripper),
+      world_(std::make_unique<World>(layout, options.gripper)),
       servos_(options.initial_joints),
       gripper_(options.gripper, options.initial_finger),
       scale_(7),
       archival_(layout, options.archival_width, options.archival_height),
       effects_(11),
       rng_(1) {
-  world_.placeArm(servos_.positions(), gripper_.position());
+  world_->placeArm(servos_.positions(), gripper_.position());
 }
 
 void Simulator::load(const Scenario& scenario) {
+  if (scenario.station_offsets != scenario_.station_offsets) moveStations(scenario.station_offsets);
   if (scenario.lighting.realism.any() && !realism_.loaded()) realism_.load(layout_.data_dir);
-  world_.spawn(scenario.sherds);
-  world_.seedSolver(scenario.seed);
+  world_->spawn(scenario.sherds);
+  world_->seedSolver(scenario.seed);
   scenario_ = scenario;
   rng_.seed(scenario.seed);
   slip_armed_ = false;
@@ -52,13 +53,25 @@ void Simulator::load(const Scenario& scenario) {
   open_requested_ = false;
 }
 
+void Simulator::moveStations(const std::map<std::string, StationOffset>& offsets) {
+  if (archival_.state() != ArchivalCamera::State::kIdle) {
+    throw std::runtime_error("station_offsets: the stations cannot move during an archival capture");
+  }
+  WorldLayout moved = layout_;  // the configured layout: offsets never add up
+  for (const auto& [name, o] : offsets) moved.offsetStation(name, o.dx, o.dy, o.dyaw);
+  // ODE's static geoms and the fixture mesh are built once: a new world, on the same clock
+  world_ = std::make_unique<World>(moved, options_.gripper, time());
+  world_->placeArm(servos_.positions(), gripper_.position());
+  archival_ = ArchivalCamera(moved, options_.archival_width, options_.archival_height);
+}
+
 void Simulator::reset() {
-  world_.release();
-  world_.spawn(scenario_.sherds);
+  world_->release();
+  world_->spawn(scenario_.sherds);
   servos_.reset(options_.initial_joints);
   gripper_.reset(options_.initial_finger);
-  world_.placeArm(servos_.positions(), gripper_.position());
-  world_.seedSolver(scenario_.seed);
+  world_->placeArm(servos_.positions(), gripper_.position());
+  world_->seedSolver(scenario_.seed);
   rng_.seed(scenario_.seed);
   slip_armed_ = false;
   drop_next_grasp_ = false;
@@ -79,7 +92,7 @@ void Simulator::commandGripper(double finger_position) {
   const double target = gripper_.target();
   if (target < previous - 1e-6 && target < q - 1e-6) {
     close_armed_ = true;
-    world_.stopIgnoringOverlaps();
+    world_->stopIgnoringOverlaps();
   } else if (target > previous + kReleaseStep && std::abs(target - q) > 1e-4) {
     // an open, even to less than where a sherd wedged the fingers (not a stop where they are)
     close_armed_ = false;
@@ -100,38 +113,38 @@ bool Simulator::squeezing() const {
   // PWM mode: the servo keeps its closing effort on an object between the fingers, so a stop
   // there does not end the close; when the object goes, the fingers go on to the close target
   if (!close_armed_ || !gripper_.closing()) return false;
-  const FingerContacts& fc = world_.fingerContacts();
-  return world_.held() >= 0 || (fc.left >= 0 && fc.left == fc.right);
+  const FingerContacts& fc = world_->fingerContacts();
+  return world_->held() >= 0 || (fc.left >= 0 && fc.left == fc.right);
 }
 
 void Simulator::step() {
   const double dt = options_.physics_dt;
   const double now = time();
   servos_.step(now, dt);
-  const FingerContacts& fc = world_.fingerContacts();
+  const FingerContacts& fc = world_->fingerContacts();
   const bool squeezed = fc.left >= 0 && fc.left == fc.right;
-  const bool blocked = world_.held() >= 0 || squeezed || fc.left_depth > 0.002 || fc.right_depth > 0.002;
+  const bool blocked = world_->held() >= 0 || squeezed || fc.left_depth > 0.002 || fc.right_depth > 0.002;
   gripper_.step(dt, blocked);
-  world_.setArmTarget(servos_.positions(), gripper_.position());
-  world_.step(dt);
+  world_->setArmTarget(servos_.positions(), gripper_.position());
+  world_->step(dt);
   updateGrasp();
-  if (scale_.update(time(), dt, world_.scaleLoad())) scale_fresh_ = true;
-  if (archival_.update(time(), world_.armPose())) archival_.deliver(time(), renderArchival(capture_exposure_ev_));
+  if (scale_.update(time(), dt, world_->scaleLoad())) scale_fresh_ = true;
+  if (archival_.update(time(), world_->armPose())) archival_.deliver(time(), renderArchival(capture_exposure_ev_));
 }
 
 void Simulator::releaseByOpening() {
-  const int held = world_.held();
-  world_.release();
+  const int held = world_->held();
+  world_->release();
   // a sherd whose box is wedged between the fingers (grasped across its corners) would stay
   // stuck there by contact friction: it passes through the arm until it is clear of it
-  world_.ignoreGripperContactsWhileOverlapping(held);
+  world_->ignoreGripperContactsWhileOverlapping(held);
   slip_armed_ = false;
   close_armed_ = false;
   open_requested_ = false;
 }
 
 void Simulator::updateGrasp() {
-  const int held = world_.held();
+  const int held = world_->held();
   if (held >= 0) {
     // the fixed joint holds only while the fingers press on the sherd: any open lets it go,
     // and it never stays attached to fingers commanded fully open
@@ -140,12 +153,12 @@ void Simulator::updateGrasp() {
       return;
     }
     if (slip_armed_) {
-      const double z = world_.sherd(held).pose.translation().z();
+      const double z = world_->sherd(held).pose.translation().z();
       if (z > grasp_z_ + 0.01) {
         if (slip_lifted_since_ < 0) slip_lifted_since_ = time();
         if (time() - slip_lifted_since_ >= slip_delay_) {
-          world_.release();
-          world_.ignoreGripperContacts(held, time() + 0.6);
+          world_->release();
+          world_->ignoreGripperContacts(held, time() + 0.6);
           slip_armed_ = false;
         }
       }
@@ -153,17 +166,17 @@ void Simulator::updateGrasp() {
     return;
   }
   open_requested_ = false;
-  const FingerContacts& fc = world_.fingerContacts();
+  const FingerContacts& fc = world_->fingerContacts();
   // only a close commanded since the last open grasps (an open to less than where a wedged
   // sherd held the fingers moves them inwards, but must not grasp it again)
   if (!close_armed_ || !gripper_.closing() || fc.left < 0 || fc.left != fc.right) return;
   const int i = fc.left;
-  world_.hold(i);
-  const SherdState s = world_.sherd(i);
+  world_->hold(i);
+  const SherdState s = world_->sherd(i);
   grasp_z_ = s.pose.translation().z();
   // Slip model (a simulator choice, not a measured figure): off-centre grasps, fingers closing
   // along the long axis and payloads above the 0.25 kg working payload slip more often.
-  const auto& arm = world_.armPose();
+  const auto& arm = world_->armPose();
   const Eigen::Vector3d c = s.pose.inverse() * arm[kEeGripperLink].translation();
   const double off = std::min(1.0, std::hypot(c.x(), c.y()) / std::max(1e-3, 0.5 * s.length));
   // along the outline's own major axis, as a person (and the detector) sees it
@@ -195,14 +208,14 @@ bool Simulator::wristFrameDue() const {
 }
 
 Eigen::Isometry3d Simulator::wristCameraPose() const {
-  return world_.armPose()[kCameraColorOpticalFrame];
+  return world_->armPose()[kCameraColorOpticalFrame];
 }
 
 WristFrame Simulator::renderWristFrame() {
   WristFrame f;
   f.stamp = time();
   f.world_T_camera = wristCameraPose();
-  world_.renderItems(items_, true);
+  world_->renderItems(items_, true);
   const CameraModel& cam = options_.wrist_model;
   renderer_.render(items_, cam, f.world_T_camera, scratch_, SensorEffects::lightGain(scenario_.lighting));
   const double speed = std::max(servos_.maxSpeed(), 0.0);
@@ -225,7 +238,7 @@ void Simulator::skipWristFrame() {
 }
 
 cv::Mat Simulator::renderArchival(double exposure_ev) {
-  world_.renderItems(items_, true);
+  world_->renderItems(items_, true);
   RenderOutput out;
   // exposure scales the light reaching the sensor, before its tone curve clips
   const Eigen::Vector3f gain = SensorEffects::lightGain(scenario_.lighting) * static_cast<float>(std::exp2(exposure_ev));
@@ -283,7 +296,7 @@ bool Simulator::injectFault(int fault, double duration, std::string& message) {
 
 std::vector<SherdState> Simulator::groundTruth() const {
   std::vector<SherdState> out;
-  for (size_t i = 0; i < world_.sherdCount(); ++i) out.push_back(world_.sherd(i));
+  for (size_t i = 0; i < world_->sherdCount(); ++i) out.push_back(world_->sherd(i));
   return out;
 }
 

@@ -14,7 +14,6 @@
 namespace rascal_sim {
 
 namespace {
-using rascal_workcell::FixtureBox;
 using rascal_workcell::Workcell;
 
 constexpr double kGravity = 9.81;
@@ -35,7 +34,7 @@ PlatformBox platformBox(const Station& scale) {
 
 /// Colour of a fixture box, by the type of the station it belongs to.
 Eigen::Vector3d fixtureColour(const WorldLayout& l, const FixtureBox& b) {
-  const Station* s = l.workcell.find(b.station);
+  const Station* s = l.find(b.station);
   if (s && s->type == StationType::Scale) return l.scale_colours[1] * 0.8;  // housing
   if (s && s->type == StationType::ArchivalCamera) return {0.3, 0.3, 0.32};  // stand
   if (s && (s->type == StationType::Discard || s->type == StationType::Bin)) {
@@ -46,7 +45,7 @@ Eigen::Vector3d fixtureColour(const WorldLayout& l, const FixtureBox& b) {
 
 /// The scale's platform among the collision boxes (its support surface): the simulator's body.
 bool isPlatform(const WorldLayout& l, const FixtureBox& b) {
-  const Station* s = l.workcell.find(b.station);
+  const Station* s = l.find(b.station);
   return b.is_support && s && s->type == StationType::Scale;
 }
 
@@ -107,7 +106,7 @@ struct World::Impl {
   int held = -1;
   FingerContacts contacts_now, contacts_last;
   Mesh fixtures;
-  std::vector<FixtureBox> boxes;  // the workcell's collision boxes, computed once
+  std::vector<FixtureBox> boxes;  // the layout's collision boxes, where they really stand
   double time = 0.0;
 
   GeomTag* tag(GeomTag::Kind k, int i) {
@@ -189,7 +188,7 @@ struct World::Impl {
     Mesh& m = fixtures;
     m.addRect(0.25, 0.0, 1.3, 1.5, 0.0, l.table_colour);
     const double mz = 0.0004;
-    for (const Station& s : l.workcell.stations()) {
+    for (const Station& s : l.stations) {
       if (s.type == StationType::Pickup || s.type == StationType::Discard || s.type == StationType::Bin) {
         m.addRect(s.area.centre.x(), s.area.centre.y(), s.area.size.x(), s.area.size.y(), mz, l.mat_colour);
       }
@@ -236,6 +235,7 @@ struct World::Impl {
     m.addBox({(boom_x0 + boom_x1) / 2, camera.area.centre.y(), lens + 0.06}, {boom_x1 - boom_x0, 0.03, 0.02},
              {0.3, 0.3, 0.32});
     m.addBox({camera.area.centre.x(), camera.area.centre.y(), lens + 0.035}, {0.11, 0.07, 0.07}, {0.08, 0.08, 0.08});
+    for (const StationMarker& k : l.markers) k.draw(m);
   }
 
   void buildPlatform(const Station& scale) {
@@ -315,8 +315,8 @@ struct World::Impl {
   }
 };
 
-World::World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& gripper)
-    : impl_(new Impl), layout_(layout) {
+World::World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& gripper, double start_time)
+    : impl_(new Impl), layout_(layout), time_(start_time) {
   odeInitOnce();
   Impl& w = *impl_;
   w.world = dWorldCreate();
@@ -334,7 +334,7 @@ World::World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& 
   dWorldSetAutoDisableTime(w.world, 0);
   w.space = dHashSpaceCreate(nullptr);
   w.contact_group = dJointGroupCreate(0);
-  w.boxes = layout.workcell.collisionBoxes();
+  w.boxes = layout.boxes;
   w.buildFixtures(layout);
   w.fixtures.cull_back_faces = true;  // boxes wound outwards, rectangles face up
   w.fixtures.updateBounds();

@@ -66,15 +66,20 @@ SimNode::SimNode(ros::NodeHandle&) {
   reset_srv_ = root.advertiseService("/sim/reset", &SimNode::onReset, this);
   fault_srv_ = root.advertiseService("/sim/inject_fault", &SimNode::onInjectFault, this);
 
-  const Station& station = config_.layout.station(StationType::Scale);
+  sendStaticFrames();
+  ROS_INFO_STREAM("sim: started with scenario " << scenario.name << " (" << scenario.sherds.size()
+                  << " sherds), real_time_factor " << config_.real_time_factor << ", wrist camera "
+                  << (config_.options.wrist_camera ? "on" : "off"));
+}
+
+void SimNode::sendStaticFrames() {
+  // where the scenario has the stations really stand (its station_offsets), as a rig's would be
+  const Station& station = sim_->world().layout().station(StationType::Scale);
   Eigen::Isometry3d scale = Eigen::Isometry3d::Identity();
   scale.translation() = Eigen::Vector3d(station.area.centre.x(), station.area.centre.y(), station.surface_z);
   static_tf_.sendTransform({conversions::toTransform(sim_->archival().pose(), "base_link",
                                                      "archival_camera_optical_frame", ros::Time(0)),
                             conversions::toTransform(scale, "base_link", "scale_link", ros::Time(0))});
-  ROS_INFO_STREAM("sim: started with scenario " << scenario.name << " (" << scenario.sherds.size()
-                  << " sherds), real_time_factor " << config_.real_time_factor << ", wrist camera "
-                  << (config_.options.wrist_camera ? "on" : "off"));
 }
 
 void SimNode::readParameters() {
@@ -300,6 +305,7 @@ bool SimNode::onSpawn(rascal_msgs::SpawnScenario::Request& req, rascal_msgs::Spa
                                                  : loader.load(resolve(workspace_, req.scenario_file));
     std::lock_guard<std::mutex> lk(mutex_);
     sim_->load(s);
+    sendStaticFrames();  // the scenario may have moved the stations
     res.success = true;
     res.count = static_cast<uint32_t>(s.sherds.size());
     res.message = "spawned " + std::to_string(res.count) + " sherds of scenario " + s.name;

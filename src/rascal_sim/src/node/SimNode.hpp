@@ -30,6 +30,8 @@ class SimNode {
 
  private:
   void readParameters();
+  /// base_link → archival_camera_optical_frame and → scale_link, where the stations stand now.
+  void sendStaticFrames();
   void onArmTrajectory(const trajectory_msgs::JointTrajectory::ConstPtr& msg);
   void onGripperCommand(const trajectory_msgs::JointTrajectory::ConstPtr& msg);
   bool onTare(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);

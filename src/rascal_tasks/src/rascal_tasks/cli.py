@@ -16,6 +16,8 @@
     rascal restore FILE [--dsn DSN] [--archive DIR] [--force]   into an empty database
     rascal rerecord FIND_ID                a lost sherd put back on the mat, into its own row
     rascal central init|add-rig|status|claim|release|push-archive   rigs and the central server
+    rascal calibrate [--output FILE]       stations measured from their ArUco markers
+    rascal calibrate --sheet PNG           the markers to print (40 mm at 300 dpi)
 
 The database comes from ``--dsn``, else ``$RASCAL_DSN``, else ``database.dsn`` of the site
 config (``--config``, else ``$RASCAL_CONFIG``, else config/rascal.yaml of the workspace; for
@@ -890,6 +892,37 @@ def _add_doctor(sub):
     doc.set_defaults(func=cmd_doctor)
 
 
+def _add_calibrate(sub):
+    p = sub.add_parser(
+        "calibrate",
+        help="measure every station's place from its ArUco markers; write a corrected layout",
+    )
+    p.add_argument(
+        "--output",
+        metavar="FILE",
+        help="where the corrected layout goes (default: rascal.calibrated.yaml beside the config)",
+    )
+
+    p.add_argument(
+        "--sheet",
+        metavar="PNG",
+        help="only write a page of the configured markers (300 dpi: print at 100 %%, each "
+        "40 mm across) and stop; the arm does not move",
+    )
+
+    def cmd_calibrate(args, out):
+        from rascal_tasks.run_calibrate import run, write_sheet
+
+        path = _config_path(args)
+        if path is None:
+            raise UsageError("no config/rascal.yaml here; pass --config")
+        if args.sheet:
+            return write_sheet(path, args.sheet, out)
+        return run(path, args.output)
+
+    p.set_defaults(func=cmd_calibrate)
+
+
 def _add_central(sub):
     from rascal_tasks.central_cli import add_central
 
@@ -1068,6 +1101,7 @@ def build_parser():
     _add_rerecord(sub)
     _add_central(sub)
     _add_doctor(sub)
+    _add_calibrate(sub)
     return p
 
 

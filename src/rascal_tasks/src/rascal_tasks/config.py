@@ -330,7 +330,66 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
                 "overlaps the archival camera stand %s" % _fmt_rect(cam.stand.area),
                 _fmt_rect(s.area),
             )
+    _check_markers(source, sec, stations, cam)
     return stations
+
+
+def _check_markers(source: str, sec: dict, stations: Dict[str, Station], cam: Station):
+    """Calibration markers (marker_calibration.py): both keys or neither, one ID once on the
+    rig, each printed square (with its white margin) on the bare table beside the stations, where
+    no sherd, mat or chart hides it and the camera can be put over it."""
+    from rascal_tasks.marker_calibration import MARKER_SIZE
+
+    seen = {}
+    for name, st in sec.items():
+        key = "stations.%s." % name
+        ids, positions = st.get("marker_ids"), st.get("marker_positions")
+        if (ids is None) != (positions is None):
+            missing = "marker_positions" if positions is None else "marker_ids"
+            _fail(
+                source,
+                key + missing,
+                "missing; a station with markers needs both " "marker_ids and marker_positions",
+                None,
+                show_got=False,
+            )
+        if ids is None:
+            continue
+        for i in ids:
+            if i != int(i):
+                _fail(source, key + "marker_ids", "expected whole marker IDs", ids)
+            if int(i) in seen:
+                _fail(
+                    source,
+                    key + "marker_ids",
+                    "marker %d is already on station %s; print " "another ID" % (i, seen[int(i)]),
+                    ids,
+                )
+            seen[int(i)] = name
+        centre = stations[name].area.center
+        for offset in positions:
+            xy = (centre[0] + offset[0], centre[1] + offset[1])
+            square = Rect(xy, (MARKER_SIZE * 4 / 3, MARKER_SIZE * 4 / 3))  # with the margin
+            for other in list(stations.values()) + [
+                Station("stand", "stand", cam.stand.area, 0.0, xy)
+            ]:
+                if square.overlaps(other.area):
+                    _fail(
+                        source,
+                        key + "marker_positions",
+                        "the marker at (%.3f, %.3f) lies on "
+                        "station %s %s; stick it on the bare table beside the station"
+                        % (xy[0], xy[1], other.name, _fmt_rect(other.area)),
+                        list(offset),
+                    )
+            if not top_down_reachable(xy[0], xy[1], 0.0):
+                _fail(
+                    source,
+                    key + "marker_positions",
+                    "the marker at (%.3f, %.3f) is outside "
+                    "the arm's top-down reach; stick it nearer the arm" % xy,
+                    list(offset),
+                )
 
 
 def _check_arm(source: str, arm: dict, stations: Dict[str, Station]):

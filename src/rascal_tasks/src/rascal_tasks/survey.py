@@ -38,10 +38,16 @@ def lawnmower(
     return poses
 
 
+def gripper_for_camera_over(x: float, y: float) -> Tuple[float, float, float]:
+    """(x, y, yaw) of ee_gripper_link, pointing down, that puts the wrist camera over (x, y):
+    the camera faces away from the base, so the gripper stays clear of what it looks at."""
+    yaw = math.atan2(y, x)
+    return x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw), yaw
+
+
 def camera_over(b, station, x, y):
     """Put the wrist camera over (x, y) of a station, at the survey height."""
-    yaw = math.atan2(y, x)
-    ex, ey = x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw)
+    ex, ey, yaw = gripper_for_camera_over(x, y)
     b.move_down(ex, ey, station.surface_z + b.config["survey"]["z"], yaw)
 
 

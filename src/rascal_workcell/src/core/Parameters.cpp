@@ -90,6 +90,10 @@ YAML::Node Parameters::lookup(const std::string& key) const {
 }
 
 bool Parameters::has(const std::string& key) const {
+  // Looking whether an optional key is there is reading it: a node that asks and finds none
+  // (a station without calibration markers) has not ignored the key.
+  const ParameterSpec* s = schema_.find(key);
+  if (s && s->readBy(reader_)) read_.insert(s->key);
   const YAML::Node n = lookup(key);
   return n.IsDefined() && !n.IsNull();
 }

@@ -19,6 +19,8 @@ MARKER = re.compile(r"(<!-- BEGIN parameters (\w+) -->\n)(.*?)(<!-- END paramete
 def _default(spec: Spec) -> str:
     if spec.required:
         return "required"
+    if spec.default is None:
+        return "none"  # optional, nothing in its place (a station without markers)
     return "`%s`" % (
         spec.default if not isinstance(spec.default, bool) else str(spec.default).lower()
     )
