@@ -12,6 +12,7 @@ import pytest
 import yaml
 
 from rascal_tasks import marker_calibration as mc
+from rascal_tasks import site_file
 from rascal_tasks.config import ConfigError, config_from_dict, load_config
 
 WORKSPACE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(__file__))))
@@ -131,7 +132,7 @@ def test_refusals_name_the_station_and_the_fix():
 def test_the_corrected_layout_moves_a_station_and_what_belongs_to_it_only():
     with open(SHIPPED, encoding="utf-8") as f:
         text = f.read()
-    out = mc.corrected_layout(text, {"camera": (0.012, -0.0205), "scale": (-0.003, 0.0)})
+    out = site_file.shift_stations(text, {"camera": (0.012, -0.0205), "scale": (-0.003, 0.0)})
     before, after = yaml.safe_load(text), yaml.safe_load(out)
     cam0, cam1 = before["stations"]["camera"], after["stations"]["camera"]
     for path in (

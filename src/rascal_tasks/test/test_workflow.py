@@ -178,7 +178,7 @@ def _dropped_on_the_way(data, world):
     s = batch.sherd = SherdRecord(batch, 4)
     s.seen(picked, batch.pickup)
     s.picked_xy, s.drops = (0.12, 0.25), 1
-    s.placed(scale)
+    s.placed(scale, s.grasp_yaw)
     return batch
 
 

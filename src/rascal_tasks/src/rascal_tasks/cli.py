@@ -18,6 +18,7 @@
     rascal central init|add-rig|status|claim|release|push-archive   rigs and the central server
     rascal calibrate [--output FILE]       stations measured from their ArUco markers
     rascal calibrate --sheet PNG           the markers to print (40 mm at 300 dpi)
+    rascal teach STATION                   jog the gripper to where sherds go there; save
 
 The database comes from ``--dsn``, else ``$RASCAL_DSN``, else ``database.dsn`` of the site
 config (``--config``, else ``$RASCAL_CONFIG``, else config/rascal.yaml of the workspace; for
@@ -923,6 +924,28 @@ def _add_calibrate(sub):
     p.set_defaults(func=cmd_calibrate)
 
 
+def _add_teach(sub):
+    p = sub.add_parser(
+        "teach",
+        help="teach where sherds are set down at a station by jogging the gripper there",
+        description="Jog the gripper, pointing down 2 cm above the station, with one command "
+        "per line: x+5, y-2.5 (mm), yaw+15 (degrees), show; save stores the measured place as "
+        "stations.STATION.taught_place in the site file (the old one kept as .bak); quit "
+        "leaves it as it was.",
+    )
+    p.add_argument("station", help="the station's name in the site file (e.g. scale, camera)")
+
+    def cmd_teach(args, out):
+        from rascal_tasks.run_teach import run
+
+        path = _config_path(args)
+        if path is None:
+            raise UsageError("no config/rascal.yaml here; pass --config")
+        return run(path, args.station, out=out)
+
+    p.set_defaults(func=cmd_teach)
+
+
 def _add_central(sub):
     from rascal_tasks.central_cli import add_central
 
@@ -1102,6 +1125,7 @@ def build_parser():
     _add_central(sub)
     _add_doctor(sub)
     _add_calibrate(sub)
+    _add_teach(sub)
     return p
 
 

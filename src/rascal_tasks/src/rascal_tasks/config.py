@@ -105,6 +105,7 @@ class Station:
     scale_bar: Optional[Fixture] = None
     stand: Optional[Fixture] = None
     rule: Optional[Rule] = None  # a sorting bin's (sorting.py)
+    place_yaw: Optional[float] = None  # [rad] gripper yaw of a taught place (else as picked up)
 
 
 @dataclass(frozen=True)
@@ -307,6 +308,8 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
                         "the station" % (cx, cy, MIN_RADIUS, _max_radius(surface_z)),
                         list(area.center),
                     )
+        if st.get("taught_place") is not None:
+            place_at, extra["place_yaw"] = _taught_place(source, key, st, area, surface_z)
         stations[name] = Station(name, type_, area, surface_z, place_at, **extra)
 
     for type_ in REQUIRED_STATION_TYPES:
@@ -332,6 +335,24 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
             )
     _check_markers(source, sec, stations, cam)
     return stations
+
+
+def _taught_place(source: str, key: str, st: dict, area: Rect, surface_z: float):
+    """A taught place ([x, y, yaw]): on the station and in the arm's reach."""
+    x, y, yaw = st["taught_place"]
+    if not area.has((x, y)):
+        _fail(
+            source,
+            key + ".taught_place",
+            "must lie on the station %s; teach it again with "
+            "`rascal teach %s`" % (_fmt_rect(area), key.split(".")[1]),
+            st["taught_place"],
+        )
+    if not top_down_reachable(x, y, surface_z):
+        _fail(source, key + ".taught_place", "outside the arm's top-down reach", st["taught_place"])
+    if abs(yaw) > math.pi:
+        _fail(source, key + ".taught_place", "yaw must be in [-pi, pi] rad", st["taught_place"])
+    return (x, y), yaw
 
 
 def _check_markers(source: str, sec: dict, stations: Dict[str, Station], cam: Station):

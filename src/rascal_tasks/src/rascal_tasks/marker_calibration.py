@@ -8,14 +8,14 @@ than the depth image. The two markers' eight corners against where the configura
 give the station's centre and its turn (a least-squares rigid fit in the plane); the distance
 between the two markers, which no move of the station changes, tells a marker that came loose.
 
-`corrected_layout` rewrites the site file's positions of a moved station (its centre, and the
-archival camera's place_at, chart, bar and stand with it) and leaves every other line, comment
-and key as it was. The rig's layout keeps stations square to the arm's base (the workcell has no
-station yaw), so a station turned more than TURN_LIMIT is not written: the operator turns it back.
+The corrected layout is the site file with a moved station's places shifted
+(`site_file.shift_stations`: its centre, a taught place, and the archival camera's place_at,
+chart, bar and stand with it), every other line, comment and key as it was. The rig's layout
+keeps stations square to the arm's base (the workcell has no station yaw), so a station turned
+more than TURN_LIMIT is not written: the operator turns it back.
 """
 
 import math
-import re
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
@@ -270,51 +270,3 @@ def check_pose(pose: StationPose) -> None:
 
 def _xy(p) -> str:
     return "(%.3f, %.3f)" % (p[0], p[1])
-
-
-# --- the corrected site file -------------------------------------------------------------------
-# Keys under a station whose [x, y] move with it (rascal_workcell schema: stations.*.…).
-_MOVING = {
-    ("position",),
-    ("place_at",),
-    ("colour_chart", "position"),
-    ("scale_bar", "position"),
-    ("stand", "position"),
-}
-_LINE = re.compile(r"^(?P<indent> *)(?P<key>[A-Za-z_][A-Za-z0-9_]*):(?P<rest>.*)$")
-_PAIR = re.compile(r"\[\s*(?P<x>[-+0-9.eE]+)\s*,\s*(?P<y>[-+0-9.eE]+)\s*\]")
-
-
-def corrected_layout(text: str, shifts: Dict[str, Tuple[float, float]]) -> str:
-    """The site file's text with every [x, y] of each shifted station moved by its shift (m),
-    to the millimetre's tenth; all other lines as they were."""
-    out, path = [], []  # path: (indent, key) of the mapping the line is in
-    for line in text.splitlines(keepends=True):
-        body = line.rstrip("\r\n")
-        end = line[len(body) :]
-        m = _LINE.match(body)
-        if not m or line.lstrip().startswith("#"):
-            out.append(line)
-            continue
-        indent = len(m.group("indent"))
-        while path and path[-1][0] >= indent:
-            path.pop()
-        keys = [k for _, k in path] + [m.group("key")]
-        path.append((indent, m.group("key")))
-        if (
-            len(keys) >= 3
-            and keys[0] == "stations"
-            and keys[1] in shifts
-            and tuple(keys[2:]) in _MOVING
-        ):
-            dx, dy = shifts[keys[1]]
-            rest = m.group("rest")
-            value, comment = (rest.split("#", 1) + [None])[:2]
-            pair = _PAIR.search(value)
-            if pair:
-                x, y = float(pair.group("x")) + dx, float(pair.group("y")) + dy
-                value = value[: pair.start()] + "[%.4f, %.4f]" % (x, y) + value[pair.end() :]
-                rest = value + ("#" + comment if comment is not None else "")
-                line = "%s%s:%s%s" % (m.group("indent"), m.group("key"), rest, end)
-        out.append(line)
-    return "".join(out)

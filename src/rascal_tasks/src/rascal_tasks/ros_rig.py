@@ -47,7 +47,7 @@ def _yaw(q) -> float:
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
-def _gripper_yaw(q) -> float:
+def gripper_yaw(q) -> float:
     """Yaw of a gripper-pointing-down orientation R = Rz(yaw) Ry(pi/2), from its closing axis
     R y = (-sin yaw, cos yaw, 0). (The usual Euler formula is degenerate at pitch pi/2.)"""
     return math.atan2(2.0 * (q.w * q.z - q.x * q.y), 1.0 - 2.0 * (q.x * q.x + q.z * q.z))
@@ -70,7 +70,7 @@ def observation_from_msg(s) -> rig.Observation:
         grasp_x=s.grasp_pose.position.x,
         grasp_y=s.grasp_pose.position.y,
         grasp_z=s.grasp_pose.position.z,
-        grasp_yaw=_gripper_yaw(s.grasp_pose.orientation),
+        grasp_yaw=gripper_yaw(s.grasp_pose.orientation),
         grasp_width=s.grasp_width,
         colour=(s.color.r, s.color.g, s.color.b),
         score=s.score,

@@ -10,37 +10,22 @@ the corrected layout goes to its own file, checked by loading it like any config
 
 import math
 import os
-import signal
 import sys
-import threading
 
 import numpy as np
 
-from rascal_tasks import exit_codes
+from rascal_tasks import exit_codes, site_file
 from rascal_tasks import marker_calibration as mc
 from rascal_tasks.config import ConfigError, load_config
 from rascal_tasks.survey import gripper_for_camera_over
 
-MASTER_TIMEOUT = 3.0  # [s]
 IMAGE_TOPIC = "/camera/color/image_raw"
 INFO_TOPIC = "/camera/color/camera_info"
-TF_WAIT = 1.0  # [s] for the camera's pose at a frame's stamp
 
 
 def fail(message: str, code: int) -> int:
     print("error: %s" % message, file=sys.stderr)
     return code
-
-
-def _rotation(q) -> np.ndarray:
-    x, y, z, w = q.x, q.y, q.z, q.w
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
 
 
 def default_output(config_path: str) -> str:
@@ -51,9 +36,7 @@ class Calibration:
     def __init__(self, config_path: str, output: str):
         self.config_path = config_path
         self.output = output or default_output(config_path)
-        self.stop = threading.Event()
-        self.arm = None
-        self.clock = None
+        self.session = None
 
     def main(self) -> int:
         try:
@@ -67,79 +50,16 @@ class Calibration:
                 "marker_positions (README, Calibrating the layout)" % self.config_path,
                 exit_codes.BAD_INPUT,
             )
-        import rospy
+        from rascal_tasks.ros_graph import Need
+        from rascal_tasks.ros_session import ArmSession, SessionError
 
-        from rascal_tasks.ros_config import load_from_param_server
-        from rascal_tasks.ros_graph import GraphError, Need, check_master, wait_for_nodes
-        from rascal_tasks.run_lock import Busy, RigLock
-
-        try:
-            uri = check_master(timeout=MASTER_TIMEOUT)
-        except GraphError as e:
-            return fail(str(e), exit_codes.FAULT)
-        rospy.init_node("rascal_calibrate", anonymous=True, disable_signals=True)
-        signal.signal(signal.SIGINT, lambda *_: self.stop.set())
-        signal.signal(signal.SIGTERM, lambda *_: self.stop.set())
-        try:
-            running = load_from_param_server()
-        except ConfigError as e:
-            return fail(str(e), exit_codes.BAD_INPUT)
-        for name, st in cfg["stations"].items():
-            if running["stations"].get(name, {}).get("position") != st["position"]:
-                return fail(
-                    "stations.%s: the running nodes use another layout than %s; `rosparam load "
-                    "%s` and restart them" % (name, self.config_path, self.config_path),
-                    exit_codes.BAD_INPUT,
-                )
-        try:
-            lock = RigLock(cfg["rig"]["name"], uri, "calibrate").acquire()
-        except Busy as e:
-            return fail(str(e), exit_codes.BUSY)
-        arm_node = ("arm_controller", "start it with rosrun rascal_control arm_controller")
         camera = ("the wrist camera", "start the simulator or rascal_drivers wrist_camera_driver")
-        needs = [
-            Need("action", "/rascal/arm/move", *arm_node),
-            Need("topic", IMAGE_TOPIC, *camera),
-            Need("topic", INFO_TOPIC, *camera),
-        ]
+        needs = [Need("topic", IMAGE_TOPIC, *camera), Need("topic", INFO_TOPIC, *camera)]
         try:
-            if not wait_for_nodes(needs, cfg["rig"]["node_wait"], uri, stopped=self.stop.is_set):
-                return fail("interrupted before anything moved", exit_codes.INTERRUPTED)
-            return self.measure(cfg, specs)
-        except GraphError as e:
-            return fail(str(e), exit_codes.FAULT)
-        finally:
-            lock.release()
-
-    def measure(self, cfg, specs) -> int:
-        import tf2_ros
-
-        from rascal_tasks.rig import RigError
-        from rascal_tasks.ros_rig import RosArm, RosClock
-
-        try:
-            self.arm = RosArm(config=cfg, stop=self.stop)
-            self.clock = RosClock(stop=self.stop)
-            self.tf = tf2_ros.Buffer()
-            self._listener = tf2_ros.TransformListener(self.tf)
-            poses, problems = [], []
-            for spec in specs:
-                seen = {}
-                for i, marker in enumerate(spec.markers):
-                    seen.update(self.look_at(cfg, marker.id, spec.marker_position(i)))
-                try:
-                    pose = mc.station_pose(spec, seen)
-                    poses.append(pose)
-                    mc.check_pose(pose)
-                except mc.CalibrationError as e:
-                    problems.append(str(e))
-        except RigError as e:
-            code = exit_codes.INTERRUPTED if self.stop.is_set() else exit_codes.FAULT
-            return fail("%s; nothing written" % e, code)
-        except mc.CalibrationError as e:
-            return fail("%s; nothing written" % e, exit_codes.FAULT)
-        finally:
-            self.park()
+            with ArmSession(cfg, self.config_path, "calibrate", needs) as self.session:
+                poses, problems = self.measure(cfg, specs)
+        except SessionError as e:
+            return fail("%s; nothing written" % e, e.code)
         self.report(poses)
         if problems:
             for p in problems:
@@ -154,21 +74,48 @@ class Calibration:
             return exit_codes.COMPLETE
         return self.write(poses, moved)
 
+    def measure(self, cfg, specs):
+        """(the stations' poses, one line per refused station); SessionError on a fault."""
+        from rascal_tasks.rig import RigError
+        from rascal_tasks.ros_session import SessionError
+
+        poses, problems = [], []
+        try:
+            for spec in specs:
+                seen = {}
+                for i, marker in enumerate(spec.markers):
+                    seen.update(self.look_at(cfg, marker.id, spec.marker_position(i)))
+                try:
+                    pose = mc.station_pose(spec, seen)
+                    poses.append(pose)
+                    mc.check_pose(pose)
+                except mc.CalibrationError as e:
+                    problems.append(str(e))
+        except RigError as e:
+            stopped = self.session.stop.is_set()
+            code = exit_codes.INTERRUPTED if stopped else exit_codes.FAULT
+            raise SessionError(str(e), code) from None
+        except mc.CalibrationError as e:
+            raise SessionError(str(e), exit_codes.FAULT) from None
+        return poses, problems
+
     def look_at(self, cfg, marker_id, xy):
         """{marker_id: its corners on the table} seen from above `xy`, or {} when not seen."""
         import rospy
         from cv_bridge import CvBridge
         from sensor_msgs.msg import CameraInfo, Image
 
+        from rascal_tasks.ros_session import rotation
+
         ex, ey, yaw = gripper_for_camera_over(*xy)
-        self.arm.move_down(ex, ey, cfg["survey"]["z"], yaw)
-        self.clock.sleep(cfg["survey"]["settle_time"])
+        self.session.arm.move_down(ex, ey, cfg["survey"]["z"], yaw)
+        self.session.clock.sleep(cfg["survey"]["settle_time"])
         at_rest = rospy.Time.now()
         wait = cfg["perception"]["frame_wait"] + 1.0
         deadline = rospy.get_time() + wait
         while True:  # a frame exposed after the arm stopped
             left = deadline - rospy.get_time()
-            if left <= 0 or self.stop.is_set():
+            if left <= 0 or self.session.stop.is_set():
                 raise mc.CalibrationError(
                     "%s: no frame after the arm stopped within %.1f s" % (IMAGE_TOPIC, wait)
                 )
@@ -179,14 +126,7 @@ class Calibration:
             if img.header.stamp >= at_rest:
                 break
         info = rospy.wait_for_message(INFO_TOPIC, CameraInfo, timeout=wait)
-        try:
-            t = self.tf.lookup_transform(
-                "base_link", img.header.frame_id, img.header.stamp, rospy.Duration(TF_WAIT)
-            )
-        except Exception as e:  # tf2's lookup, connectivity and extrapolation errors alike
-            raise mc.CalibrationError(
-                "TF base_link -> %s at the frame's stamp: %s" % (img.header.frame_id, e)
-            ) from None
+        t = self.session.transform(img.header.frame_id, img.header.stamp)
         bgr = CvBridge().imgmsg_to_cv2(img, "bgr8")
         corners = mc.detect_markers(bgr).get(marker_id)
         if corners is None:
@@ -196,18 +136,10 @@ class Calibration:
             corners,
             np.array(info.K).reshape(3, 3),
             np.array(info.D) if info.D else None,
-            _rotation(t.transform.rotation),
+            np.array(rotation(t.transform.rotation)),
             np.array([tr.x, tr.y, tr.z]),
         )
         return {marker_id: on_table}
-
-    def park(self):
-        if self.arm is None:
-            return
-        try:
-            self.arm.go("sleep")
-        except Exception as e:  # parking is the last thing tried; say why it did not happen
-            print("error: the arm could not be parked: %s" % e, file=sys.stderr)
 
     def report(self, poses):
         print(
@@ -232,7 +164,7 @@ class Calibration:
     def write(self, poses, moved) -> int:
         with open(self.config_path, encoding="utf-8") as f:
             text = f.read()
-        corrected = mc.corrected_layout(text, moved)
+        corrected = site_file.shift_stations(text, moved)
         tmp = self.output + ".tmp"
         with open(tmp, "w", encoding="utf-8") as f:
             f.write(corrected)

@@ -74,8 +74,10 @@ class SherdRecord:
         self.grasp_yaw, self.width = o.grasp_yaw, o.width
         self.grasp_height = o.grasp_z - station.surface_z
 
-    def placed(self, station):
+    def placed(self, station, yaw: float):
+        """Set down on `station` by a gripper turned to `yaw`: picked up again as it lies."""
         self.where, self.last_xy = station.name, tuple(station.place_at)
+        self.grasp_yaw = yaw
 
     def station_done(self, index: int):
         self.station_index = index

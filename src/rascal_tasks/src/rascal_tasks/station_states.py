@@ -11,6 +11,12 @@ from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
 
 
+def place_yaw(station, sherd) -> float:
+    """The gripper's yaw at a station: the taught one (`rascal teach`), else as picked up (no
+    wrist turn on the way)."""
+    return sherd.grasp_yaw if station.place_yaw is None else station.place_yaw
+
+
 class Translate(BatchState):
     """Carry the sherd to a station at travel height; a drop on the way goes to RECOVER."""
 
@@ -24,7 +30,7 @@ class Translate(BatchState):
     def run(self):
         b = self.batch
         st = b.plugins[self.index].target(b.sherd)
-        b.move_down(*st.place_at, b.travel_z(), b.sherd.grasp_yaw)
+        b.move_down(*st.place_at, b.travel_z(), place_yaw(st, b.sherd))
         if not b.rig.gripper.holding():
             b.sherd.dropped("while carrying to %s" % st.name)
             return "dropped"
@@ -47,18 +53,17 @@ class Place(BatchState):
         s = b.sherd
         st = plugin.target(s)
         plugin.before_place(s)
+        yaw = place_yaw(st, s)
         if not plugin.release_from_above:
             z = st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
-            b.move_down(*st.place_at, z, s.grasp_yaw, linear=True)
+            b.move_down(*st.place_at, z, yaw, linear=True)
         with b.phase("grasping"):
             b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
         if plugin.hover_after_place:
-            b.move_down(
-                *st.place_at, z + b.config["arm"]["approach_offset"], s.grasp_yaw, linear=True
-            )
+            b.move_down(*st.place_at, z + b.config["arm"]["approach_offset"], yaw, linear=True)
         elif not plugin.release_from_above:
-            b.move_down(*st.place_at, b.travel_z(), s.grasp_yaw, linear=True)
-        s.placed(st)
+            b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
+        s.placed(st, yaw)
         return "placed"
 
 

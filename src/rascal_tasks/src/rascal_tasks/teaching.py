@@ -1,0 +1,154 @@
+"""Teaching a station's place by demonstration (issue 17 item 6). No ROS in here.
+
+The person jogs the gripper, pointing down just above the station's surface, to where a sherd
+should be set down and turned as it should lie (for the archival photo: along the scale bar),
+and saves: `stations.<name>.taught_place: [x, y, yaw]`, which later batches use (station_states:
+PLACE_i and TRANSLATE_i). Every jog is a checked move and the pose saved is the one measured after
+it (forward kinematics through TF), never the one asked for.
+
+Commands, one per line (a terminal or a pipe): `x+5` / `y-2.5` (millimetres, base_link axes:
+x away from the arm, y to its left), `yaw+15` (degrees, anticlockwise seen from above), `show`,
+`save`, `quit`.
+"""
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Callable, Iterable, Optional, TextIO, Tuple
+
+from rascal_tasks.rig import RigError
+from rascal_tasks.stations import STATION_PLUGINS
+
+# The gripper's tip this high above the station's surface while teaching: low enough to judge
+# where the sherd will lie, clear of the surface and of a sherd lying there.
+TEACH_HEIGHT = 0.02  # [m]
+# The measured pose must be this close to the one asked for (the controller's goal tolerance
+# is 0.002 rad per joint: about 1 mm at the gripper).
+ARRIVED_XY = 0.002  # [m]
+ARRIVED_YAW = math.radians(1.0)  # [rad]
+# The controller's answers to a jog that leave the arm where it was: said, and teaching goes on.
+REFUSED_MOVES = ("UNREACHABLE", "COLLISION")
+_JOG = re.compile(r"^(x|y|yaw)\s*([+-])\s*(\d+(?:\.\d*)?)$")
+
+
+class TeachError(Exception):
+    """One line for the person teaching; the session goes on (or, from the arm, stops)."""
+
+
+@dataclass(frozen=True)
+class Place:
+    x: float  # [m]
+    y: float  # [m]
+    yaw: float  # [rad]
+
+    def text(self) -> str:
+        return "(%.4f, %.4f) m, yaw %.1f°" % (
+            self.x,
+            self.y,
+            round(math.degrees(self.yaw), 1) + 0.0,
+        )
+
+
+def wrap(angle: float) -> float:
+    """The same direction in [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def jogged(place: Place, command: str, area) -> Place:
+    """`place` moved by one jog command; TeachError for a command that is not one or a place off
+    the station (`area`: config.Rect)."""
+    m = _JOG.match(command.strip().lower())
+    if not m:
+        raise TeachError(
+            "%r: not a command; x+5, y-2.5 (mm), yaw+15 (degrees), show, save or quit" % command
+        )
+    axis, sign, amount = m.group(1), m.group(2), float(m.group(3))
+    step = amount if sign == "+" else -amount
+    if axis == "yaw":
+        return Place(place.x, place.y, wrap(place.yaw + math.radians(step)))
+    new = Place(
+        place.x + step / 1000 * (axis == "x"), place.y + step / 1000 * (axis == "y"), place.yaw
+    )
+    if not area.has((new.x, new.y)):
+        raise TeachError(
+            "%s: would leave the station (x %.3f..%.3f, y %.3f..%.3f m); the place must lie on it"
+            % (
+                command.strip(),
+                area.center[0] - area.size[0] / 2,
+                area.center[0] + area.size[0] / 2,
+                area.center[1] - area.size[1] / 2,
+                area.center[1] + area.size[1] / 2,
+            )
+        )
+    return new
+
+
+def _yaw_gap(a: float, b: float) -> float:
+    """Angle between two gripper yaws; the two fingers are alike, so a half turn is none."""
+    d = abs(wrap(a - b)) % math.pi
+    return min(d, math.pi - d)
+
+
+def teach_height(station, travel_z: float) -> float:
+    """ee_gripper_link's height while teaching: where the sherd is let go (a box's sherds fall
+    from travel height; elsewhere they are set down on the surface)."""
+    from_above = station.type == "bin" or STATION_PLUGINS[station.type].release_from_above
+    return travel_z if from_above else station.surface_z + TEACH_HEIGHT
+
+
+def teach(
+    station,
+    start: Place,
+    move: Callable[[Place, float], None],
+    measure: Callable[[], Tuple[float, float, float, float]],
+    commands: Iterable[str],
+    out: TextIO,
+    z: float,
+) -> Optional[Place]:
+    """One teaching session at `station` (config.Station): the gripper to `start` at height `z`,
+    then each command. `move(place, z)` puts the gripper there pointing down (a RigError when it
+    cannot: a jog the controller refuses, unreachable or colliding, is said and ignored; any other
+    ends the session); `measure()` is its pose now, (x, y, z, yaw) in base_link. Returns the
+    measured place on `save`, None on `quit` or the end of the commands."""
+    wanted = start
+    here = _go(move, measure, wanted, z)
+    print("at %s; jog with x+5, y-2.5 (mm), yaw+15 (°); then save or quit" % here.text(), file=out)
+    for line in commands:
+        command = line.strip().lower()
+        if not command:
+            continue
+        if command == "quit":
+            return None
+        if command == "save":
+            return here
+        if command == "show":
+            print("at %s" % here.text(), file=out)
+            continue
+        try:
+            nxt = jogged(wanted, command, station.area)
+        except TeachError as e:
+            print("refused: %s" % e, file=out)
+            continue
+        try:
+            here, wanted = _go(move, measure, nxt, z), nxt
+        except RigError as e:
+            if e.code not in REFUSED_MOVES:
+                raise
+            print("refused: %s: %s" % (command, e.reason), file=out)
+            continue
+        print("at %s" % here.text(), file=out)
+    return None
+
+
+def _go(move, measure, place: Place, z: float) -> Place:
+    """Move, then the place as measured; TeachError when the arm is not where it was sent."""
+    move(place, z)
+    x, y, _, yaw = measure()
+    got = Place(x, y, yaw)
+    if math.hypot(x - place.x, y - place.y) > ARRIVED_XY or _yaw_gap(yaw, place.yaw) > ARRIVED_YAW:
+        raise TeachError(
+            "the gripper is at %s, not at %s where it was sent; nothing saved"
+            % (got.text(), place.text())
+        )
+    # the fingers are alike: a yaw measured half a turn off is the one asked for
+    return Place(x, y, yaw if abs(wrap(yaw - place.yaw)) <= math.pi / 2 else wrap(yaw + math.pi))
