@@ -151,3 +151,30 @@ def test_arm_controller_runs_unchanged_on_the_driver(ros_master, rosrun, bus):
     assert "torque off on every servo" in text
     with bus.lock:
         assert not any(s.get("torque_enable") for s in bus.servos.values())
+
+
+def test_the_arm_goes_limp_for_teaching_by_hand_and_holds_where_it_is_left(ros_master, rosrun, bus):
+    load(ros_master, bus.link)
+    node = rosrun("rascal_drivers", "arm_driver")
+    assert wait_for_torque(bus, True), output(node)
+
+    def limp(on):
+        res = ros_master.run(
+            ["rosservice", "call", "/arm/limp", "data: %s" % ("true" if on else "false")],
+            timeout=30,
+        )
+        assert "success: True" in res.stdout, res.stdout + res.stderr
+
+    limp(True)
+    with bus.lock:
+        assert [bus.servos[i].get("torque_enable") for i in range(1, 10)] == [0] * 8 + [1]
+        bus.servos[1].position += 300  # the waist turned by hand
+        left = bus.servos[1].position
+    time.sleep(0.3)
+    limp(False)
+    assert wait_for_torque(bus, True), output(node)
+    time.sleep(0.5)
+    with bus.lock:  # holding where the hands left it: the goal is there, not the old one
+        assert abs(bus.servos[1].get("goal_position") - left) <= 2
+        assert abs(bus.servos[1].position - left) <= 2
+    stop(node)

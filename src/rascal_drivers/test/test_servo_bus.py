@@ -192,3 +192,32 @@ def test_bad_arm_parameters_are_named(overrides, message):
 def test_no_latency_warning_for_a_pty_or_a_missing_device(emulator):
     # a pty has no USB latency timer; on the rig an FTDI adapter at 16 ms gets one line
     assert latency_warning(emulator.device) == "" and latency_warning("/dev/nothing") == ""
+
+
+def test_a_limp_arm_is_moved_by_hand_and_holds_where_it_was_left(emulator):
+    driver = driver_on(emulator)
+    driver.cycle(time.monotonic())
+    before = list(driver.last.position[:6])
+    assert driver.set_limp(True) == ""
+    assert all(emulator.servos[i].get("torque_enable") == 0 for i in range(1, 9))
+    assert emulator.servos[9].get("torque_enable") == 1  # the gripper keeps its grip
+    assert driver.on_trajectory(["waist"], [(0.0, [0.3])], time.monotonic()).startswith(
+        "refused: the arm is limp"
+    )
+    waist = emulator.servos[1]
+    waist.position += 300  # a person turns the waist by hand (about 26°)
+    for _ in range(20):
+        driver.cycle(time.monotonic())
+        time.sleep(0.005)
+    moved = driver.last.position[0]
+    assert moved - before[0] == pytest.approx(300 * 2 * math.pi / 4096, abs=0.01)
+    assert driver.set_limp(False) == ""
+    assert all(emulator.servos[i].get("torque_enable") == 1 for i in range(1, 9))
+    end = time.monotonic() + 0.5
+    while time.monotonic() < end:  # held where it was left, not sprung back
+        driver.cycle(time.monotonic())
+        time.sleep(0.005)
+    assert driver.last.position[0] == pytest.approx(moved, abs=0.005)
+    assert driver.on_trajectory(["waist"], [(0.0, [moved])], time.monotonic()) == ""
+    driver.bus.torque_off()
+    driver.bus.close()

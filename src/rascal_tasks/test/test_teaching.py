@@ -155,3 +155,26 @@ def test_a_batch_sets_sherds_down_where_and_as_taught(data):
     assert len(at_scale) >= 4, world.moves  # set down and picked up again, each sherd
     assert all(m[3] == pytest.approx(1.2) for m in at_scale)
     assert not [m for m in world.moves if m[2] < low and math.hypot(m[0] - 0.30, m[1]) < 0.01]
+
+
+def test_taught_by_hand_the_place_read_is_saved_and_the_torque_always_comes_back(data):
+    scale = config_from_dict(data).stations["scale"]
+    torque, out = [], io.StringIO()
+    poses = iter([(0.50, 0.0, 0.05, 0.0), (0.31, 0.012, 0.05, 0.4)])
+    got = teaching.teach_by_hand(
+        scale, torque.append, lambda: next(poses), ["save", "wiggle", "", "", "save"], out
+    )
+    assert (got.x, got.y, got.yaw) == (0.31, 0.012, 0.4)
+    assert torque == [True, False]
+    text = out.getvalue()
+    assert "is not on the station" in text and "refused: 'wiggle'" in text
+    assert "nothing read yet" in text
+
+    def broken():
+        raise RigError("tf", "LOOKUP", "no transform")
+
+    torque.clear()
+    with pytest.raises(RigError):
+        teaching.teach_by_hand(scale, torque.append, broken, [""], out)
+    assert torque == [True, False]
+    assert teaching.teach_by_hand(scale, torque.append, broken, ["quit"], out) is None

@@ -357,11 +357,23 @@ class ArmBus:
                     found.append("%s: %s" % (self._where(role), ct.describe_hardware_error(status)))
         return "hardware error on " + "; ".join(found) if found else ""
 
-    def write_goals(self, arm: List[float], finger: Optional[float]) -> None:
-        """Goal positions of the six arm joints [rad] and the left finger [m], in one sync write
-        (the shadows follow their primaries through the Secondary ID)."""
+    def set_arm_torque(self, on: bool) -> None:
+        """Torque of the arm's servos (not the gripper's) off, so a person can move the arm by
+        hand, or on again holding where the arm now is: each goal is set to its servo's present
+        position first, or the arm would spring back to where it was before."""
+        arm_roles = [r for r in ROLES if r != "gripper"]
+        if on:
+            for role in arm_roles:
+                self._write(role, "goal_position", self._read(role, "present_position"))
+        for role in arm_roles:
+            self._write(role, "torque_enable", 1 if on else 0)
+
+    def write_goals(self, arm: Optional[List[float]], finger: Optional[float]) -> None:
+        """Goal positions of the six arm joints [rad] (None: none, the arm is limp) and the left
+        finger [m], in one sync write (the shadows follow their primaries through the Secondary
+        ID)."""
         self._writer.clearParam()
-        goals = dict(zip(ARM_JOINTS, arm, strict=True))
+        goals = dict(zip(ARM_JOINTS, arm, strict=True)) if arm is not None else {}
         if finger is not None:
             goals["gripper"] = finger_linkage.angle_from_finger(finger)
         for role, rad in goals.items():

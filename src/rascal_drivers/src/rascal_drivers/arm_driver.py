@@ -20,6 +20,7 @@ class ArmDriver:
         self.finger: Optional[float] = None  # target of the left finger [m]
         self.fault = ""
         self.last: Optional[JointSample] = None
+        self.limp = False  # arm torque off for teaching by hand (the gripper keeps its own)
 
     def _arm_now(self) -> List[float]:
         return list(self.last.position[: len(ARM_JOINTS)]) if self.last else []
@@ -34,7 +35,30 @@ class ArmDriver:
             return "refused: no joint state read from the servos yet"
         if not any(n in ARM_JOINTS for n in names):
             return ""
+        if self.limp:
+            return "refused: the arm is limp for teaching by hand; its torque comes back first"
         self.follower.replace(names, points, start, self._arm_now())
+        return ""
+
+    def set_limp(self, limp: bool) -> str:
+        """Arm torque off (a person moves the arm by hand) or on again, holding where the arm
+        is then; '' when done, else why not (one line)."""
+        if self.fault:
+            return "refused: " + self.fault
+        if self.last is None:
+            return "refused: no joint state read from the servos yet"
+        if limp == self.limp:
+            return ""
+        if limp:
+            self.follower.stop(self._arm_now())
+            self.bus.set_arm_torque(False)
+        else:
+            sample = self.bus.read_state()  # where the hands left it, not the last cycle's
+            if sample is not None:
+                self.last = sample
+            self.follower.stop(self._arm_now())
+            self.bus.set_arm_torque(True)
+        self.limp = limp
         return ""
 
     def on_gripper(self, names: Sequence[str], positions: Optional[Sequence[float]]) -> str:
@@ -69,6 +93,6 @@ class ArmDriver:
                     self.follower.stop(self._arm_now())
                     self.finger = self.last.position[len(ARM_JOINTS)]
         if self.last is not None:
-            goal = self.follower.sample(now, self._arm_now())
+            goal = None if self.limp else self.follower.sample(now, self._arm_now())
             self.bus.write_goals(goal, self.finger)
         return sample, new_fault

@@ -18,7 +18,7 @@
     rascal central init|add-rig|status|claim|release|push-archive   rigs and the central server
     rascal calibrate [--output FILE]       stations measured from their ArUco markers
     rascal calibrate --sheet PNG           the markers to print (40 mm at 300 dpi)
-    rascal teach STATION                   jog the gripper to where sherds go there; save
+    rascal teach STATION [--hand]          jog (or move by hand) the gripper to where sherds go
 
 The database comes from ``--dsn``, else ``$RASCAL_DSN``, else ``database.dsn`` of the site
 config (``--config``, else ``$RASCAL_CONFIG``, else config/rascal.yaml of the workspace; for
@@ -934,6 +934,11 @@ def _add_teach(sub):
         "leaves it as it was.",
     )
     p.add_argument("station", help="the station's name in the site file (e.g. scale, camera)")
+    p.add_argument(
+        "--hand",
+        action="store_true",
+        help="field rig: the arm's torque off, move the gripper there by hand and press Enter",
+    )
 
     def cmd_teach(args, out):
         from rascal_tasks.run_teach import run
@@ -941,7 +946,7 @@ def _add_teach(sub):
         path = _config_path(args)
         if path is None:
             raise UsageError("no config/rascal.yaml here; pass --config")
-        return run(path, args.station, out=out)
+        return run(path, args.station, out=out, hand=args.hand)
 
     p.set_defaults(func=cmd_teach)
 

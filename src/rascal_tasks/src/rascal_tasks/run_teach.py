@@ -20,7 +20,11 @@ def fail(message: str, code: int) -> int:
     return code
 
 
-def run(config_path: str, station_name: str, commands=None, out=sys.stdout) -> int:
+LIMP_SERVICE = "/arm/limp"  # rascal_drivers arm_driver: the arm's torque off and on
+LIMP_WAIT = 3.0  # [s]
+
+
+def run(config_path: str, station_name: str, commands=None, out=sys.stdout, hand=False) -> int:
     try:
         cfg = load_config(config_path)
     except ConfigError as e:
@@ -48,6 +52,9 @@ def run(config_path: str, station_name: str, commands=None, out=sys.stdout) -> i
     start = teaching.Place(*station.place_at, station.place_yaw or 0.0)
     try:
         with ArmSession(cfg, config_path, "teach") as s:
+            if hand:
+                place = _by_hand(s, station, commands or sys.stdin, out)
+                return _saved_or_not(config_path, station_name, place, out)
             travel_z = cfg["arm"]["travel_z"]
             at = []  # where the gripper was last sent
 
@@ -78,10 +85,42 @@ def run(config_path: str, station_name: str, commands=None, out=sys.stdout) -> i
                         print("error: lifting before parking: %s" % e, file=sys.stderr)
     except SessionError as e:
         return fail(str(e), e.code)
+    return _saved_or_not(config_path, station_name, place, out)
+
+
+def _saved_or_not(config_path, station_name, place, out) -> int:
     if place is None:
         print("nothing saved; %s is as it was" % config_path, file=out)
         return exit_codes.INCOMPLETE
     return save(config_path, station_name, place, out)
+
+
+def _by_hand(s, station, commands, out):
+    """teaching.teach_by_hand on the field rig's arm driver (its /arm/limp service)."""
+    import rospy
+    from std_srvs.srv import SetBool
+
+    from rascal_tasks.ros_session import SessionError
+
+    try:
+        rospy.wait_for_service(LIMP_SERVICE, timeout=LIMP_WAIT)
+    except rospy.ROSException:
+        raise SessionError(
+            "%s: no arm driver offers it (the simulator's arm cannot be moved by hand); teach "
+            "without --hand, by jogging" % LIMP_SERVICE,
+            exit_codes.BAD_INPUT,
+        ) from None
+    call = rospy.ServiceProxy(LIMP_SERVICE, SetBool)
+
+    def limp(on):
+        try:
+            res = call(on)
+        except rospy.ServiceException as e:
+            raise SessionError("%s: %s" % (LIMP_SERVICE, e), exit_codes.FAULT) from None
+        if not res.success:
+            raise SessionError("%s: %s" % (LIMP_SERVICE, res.message), exit_codes.FAULT)
+
+    return teaching.teach_by_hand(station, limp, s.gripper_pose, commands, out)
 
 
 def save(config_path: str, station: str, place: teaching.Place, out) -> int:

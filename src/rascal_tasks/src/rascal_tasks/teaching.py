@@ -140,6 +140,52 @@ def teach(
     return None
 
 
+def teach_by_hand(
+    station,
+    limp: Callable[[bool], None],
+    measure: Callable[[], Tuple[float, float, float, float]],
+    commands: Iterable[str],
+    out: TextIO,
+) -> Optional[Place]:
+    """Teaching on the field rig with the arm's torque off: the person puts the gripper where a
+    sherd should be let go, pointing down, and presses Enter (an empty line); the place is read,
+    checked against the station and offered: `save`, or Enter again to take another. The torque
+    comes back (holding the arm where it was left) before this returns, whatever happened."""
+    limp(True)
+    try:
+        print(
+            "the arm is limp: hold it, put the gripper where a sherd should be let go, pointing "
+            "down, and press Enter (quit: leave)",
+            file=out,
+        )
+        here = None
+        for line in commands:
+            command = line.strip().lower()
+            if command == "quit":
+                return None
+            if command == "save":
+                if here is not None:
+                    return here
+                print("refused: nothing read yet; press Enter to read the place", file=out)
+                continue
+            if command:
+                print("refused: %r: press Enter to read the place, then save" % command, file=out)
+                continue
+            x, y, _, yaw = measure()
+            if not station.area.has((x, y)):
+                print(
+                    "refused: (%.4f, %.4f) m is not on the station; move it there" % (x, y),
+                    file=out,
+                )
+                here = None
+                continue
+            here = Place(x, y, yaw)
+            print("read %s: save, or move it and press Enter again" % here.text(), file=out)
+        return None
+    finally:
+        limp(False)
+
+
 def _go(move, measure, place: Place, z: float) -> Place:
     """Move, then the place as measured; TeachError when the arm is not where it was sent."""
     move(place, z)
