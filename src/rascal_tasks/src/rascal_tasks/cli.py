@@ -82,6 +82,14 @@ def _config_path(args):
     return None
 
 
+def _required_config_path(args):
+    """The site config for a verb that cannot do without one; UsageError when there is none."""
+    path = _config_path(args)
+    if path is None:
+        raise UsageError("no config/rascal.yaml here; pass --config")
+    return path
+
+
 def resolve_database(args, cfg=None):
     """``(dsn, connect_timeout, where_it_came_from)``: ``--dsn``, else ``$RASCAL_DSN``, else
     ``database.dsn`` of `cfg` (the configuration a run already loaded) or of the site config
@@ -883,9 +891,7 @@ def _add_doctor(sub):
     def cmd_doctor(args, out):
         from rascal_drivers import doctor
 
-        path = _config_path(args)
-        if path is None:
-            raise UsageError("no config/rascal.yaml here; pass --config")
+        path = _required_config_path(args)
         cfg = load_site_config(path)
         items = doctor.check_rig(cfg["drivers"], only=tuple(args.device or doctor.DEVICES))
         return exit_codes.COMPLETE if doctor.report(items, out) else exit_codes.FAULT
@@ -903,7 +909,6 @@ def _add_calibrate(sub):
         metavar="FILE",
         help="where the corrected layout goes (default: rascal.calibrated.yaml beside the config)",
     )
-
     p.add_argument(
         "--sheet",
         metavar="PNG",
@@ -914,9 +919,7 @@ def _add_calibrate(sub):
     def cmd_calibrate(args, out):
         from rascal_tasks.run_calibrate import run, write_sheet
 
-        path = _config_path(args)
-        if path is None:
-            raise UsageError("no config/rascal.yaml here; pass --config")
+        path = _required_config_path(args)
         if args.sheet:
             return write_sheet(path, args.sheet, out)
         return run(path, args.output)
@@ -943,9 +946,7 @@ def _add_teach(sub):
     def cmd_teach(args, out):
         from rascal_tasks.run_teach import run
 
-        path = _config_path(args)
-        if path is None:
-            raise UsageError("no config/rascal.yaml here; pass --config")
+        path = _required_config_path(args)
         return run(path, args.station, out=out, hand=args.hand)
 
     p.set_defaults(func=cmd_teach)
