@@ -8,3 +8,11 @@ BAD_INPUT = 2  # configuration, context ID or arguments are wrong: nothing moved
 FAULT = 3  # a device, the driver, the database or the archive failed: arm parked, run again
 BUSY = 4  # another run holds this rig or this context: nothing moved
 INTERRUPTED = 130  # Ctrl-C or SIGTERM: arm parked; run again to resume
+
+
+def fail(message: str, code: int) -> int:
+    """A verb ending with one line on stderr (`error: ...`); returns `code` to exit with."""
+    import sys
+
+    print("error: %s" % message, file=sys.stderr)
+    return code

@@ -31,11 +31,6 @@ class SessionError(Exception):
         self.code = code
 
 
-def fail(message: str, code: int) -> int:
-    print("error: %s" % message, file=sys.stderr)
-    return code
-
-
 def rotation(q):
     """3 x 3 rotation matrix (nested lists) of a geometry_msgs Quaternion."""
     x, y, z, w = q.x, q.y, q.z, q.w

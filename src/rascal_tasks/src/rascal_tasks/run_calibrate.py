@@ -23,11 +23,6 @@ IMAGE_TOPIC = "/camera/color/image_raw"
 INFO_TOPIC = "/camera/color/camera_info"
 
 
-def fail(message: str, code: int) -> int:
-    print("error: %s" % message, file=sys.stderr)
-    return code
-
-
 def default_output(config_path: str) -> str:
     return os.path.join(os.path.dirname(os.path.abspath(config_path)), "rascal.calibrated.yaml")
 
@@ -42,10 +37,10 @@ class Calibration:
         try:
             cfg = load_config(self.config_path)
         except ConfigError as e:
-            return fail(str(e), exit_codes.BAD_INPUT)
+            return exit_codes.fail(str(e), exit_codes.BAD_INPUT)
         specs = mc.stations_with_markers(cfg)
         if not specs:
-            return fail(
+            return exit_codes.fail(
                 "%s: no station has calibration markers; add stations.<name>.marker_ids and "
                 "marker_positions (README, Calibrating the layout)" % self.config_path,
                 exit_codes.BAD_INPUT,
@@ -59,12 +54,12 @@ class Calibration:
             with ArmSession(cfg, self.config_path, "calibrate", needs) as self.session:
                 poses, problems = self.measure(cfg, specs)
         except SessionError as e:
-            return fail("%s; nothing written" % e, e.code)
+            return exit_codes.fail("%s; nothing written" % e, e.code)
         self.report(poses)
         if problems:
             for p in problems:
                 print("error: %s" % p, file=sys.stderr)
-            return fail("nothing written", exit_codes.INCOMPLETE)
+            return exit_codes.fail("nothing written", exit_codes.INCOMPLETE)
         moved = {p.station: p.shift for p in poses if p.shift_norm > mc.POSITION_TOLERANCE}
         if not moved:
             print(
@@ -125,7 +120,10 @@ class Calibration:
                 continue
             if img.header.stamp >= at_rest:
                 break
-        info = rospy.wait_for_message(INFO_TOPIC, CameraInfo, timeout=wait)
+        try:
+            info = rospy.wait_for_message(INFO_TOPIC, CameraInfo, timeout=wait)
+        except rospy.ROSException:
+            raise mc.CalibrationError("%s: none within %.1f s" % (INFO_TOPIC, wait)) from None
         t = self.session.transform(img.header.frame_id, img.header.stamp)
         bgr = CvBridge().imgmsg_to_cv2(img, "bgr8")
         corners = mc.detect_markers(bgr).get(marker_id)
@@ -176,7 +174,7 @@ class Calibration:
                     raise ConfigError("stations.%s.position: not rewritten" % p.station)
         except ConfigError as e:
             os.unlink(tmp)
-            return fail(
+            return exit_codes.fail(
                 "the corrected layout is refused: %s; nothing written" % e, exit_codes.FAULT
             )
         os.replace(tmp, self.output)
@@ -197,9 +195,9 @@ def write_sheet(config_path: str, path: str, out=sys.stdout) -> int:
             raise ConfigError("%s: no station has calibration markers" % config_path)
         page = mc.marker_sheet(specs)
     except (ConfigError, mc.CalibrationError) as e:
-        return fail(str(e), exit_codes.BAD_INPUT)
+        return exit_codes.fail(str(e), exit_codes.BAD_INPUT)
     if not cv2.imwrite(path, page):
-        return fail(
+        return exit_codes.fail(
             "%s: cannot be written (a .png path in a folder that exists)" % path, exit_codes.FAULT
         )
     print(

@@ -15,11 +15,6 @@ from rascal_tasks.config import ConfigError, load_config
 TEACHABLE = ("scale", "archival_camera", "discard", "bin")
 
 
-def fail(message: str, code: int) -> int:
-    print("error: %s" % message, file=sys.stderr)
-    return code
-
-
 LIMP_SERVICE = "/arm/limp"  # rascal_drivers arm_driver: the arm's torque off and on
 LIMP_WAIT = 3.0  # [s]
 
@@ -28,16 +23,16 @@ def run(config_path: str, station_name: str, commands=None, out=sys.stdout, hand
     try:
         cfg = load_config(config_path)
     except ConfigError as e:
-        return fail(str(e), exit_codes.BAD_INPUT)
+        return exit_codes.fail(str(e), exit_codes.BAD_INPUT)
     station = cfg.stations.get(station_name)
     if station is None:
-        return fail(
+        return exit_codes.fail(
             "no station %r in %s; its stations: %s"
             % (station_name, config_path, ", ".join(cfg.stations)),
             exit_codes.BAD_INPUT,
         )
     if station.type not in TEACHABLE:
-        return fail(
+        return exit_codes.fail(
             "stations.%s: sherds are not set down on a %s station; teach one of %s"
             % (
                 station_name,
@@ -84,7 +79,7 @@ def run(config_path: str, station_name: str, commands=None, out=sys.stdout, hand
                     except RigError as e:
                         print("error: lifting before parking: %s" % e, file=sys.stderr)
     except SessionError as e:
-        return fail(str(e), e.code)
+        return exit_codes.fail(str(e), e.code)
     return _saved_or_not(config_path, station_name, place, out)
 
 
@@ -130,7 +125,7 @@ def save(config_path: str, station: str, place: teaching.Place, out) -> int:
     try:
         changed = site_file.set_station_value(text, station, "taught_place", values)
     except ValueError as e:
-        return fail("%s; nothing saved" % e, exit_codes.BAD_INPUT)
+        return exit_codes.fail("%s; nothing saved" % e, exit_codes.BAD_INPUT)
     tmp = config_path + ".tmp"
     with open(tmp, "w", encoding="utf-8") as f:
         f.write(changed)
@@ -140,7 +135,7 @@ def save(config_path: str, station: str, place: teaching.Place, out) -> int:
             raise ConfigError("stations.%s.taught_place: not written (got %r)" % (station, got))
     except ConfigError as e:
         os.unlink(tmp)
-        return fail("%s; nothing saved" % e, exit_codes.FAULT)
+        return exit_codes.fail("%s; nothing saved" % e, exit_codes.FAULT)
     shutil.copy2(config_path, config_path + ".bak")
     os.replace(tmp, config_path)
     print(
