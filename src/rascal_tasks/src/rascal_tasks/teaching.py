@@ -66,9 +66,8 @@ def jogged(place: Place, command: str, area) -> Place:
     step = amount if sign == "+" else -amount
     if axis == "yaw":
         return Place(place.x, place.y, wrap(place.yaw + math.radians(step)))
-    new = Place(
-        place.x + step / 1000 * (axis == "x"), place.y + step / 1000 * (axis == "y"), place.yaw
-    )
+    dx, dy = (step / 1000, 0.0) if axis == "x" else (0.0, step / 1000)
+    new = Place(place.x + dx, place.y + dy, place.yaw)
     if not area.has((new.x, new.y)):
         raise TeachError(
             "%s: would leave the station (x %.3f..%.3f, y %.3f..%.3f m); the place must lie on it"
