@@ -25,7 +25,8 @@ APT_PACKAGES=(
   # kinematics, robot model
   liborocos-kdl-dev libkdl-parser-dev python3-pykdl liburdfdom-dev liburdfdom-tools libeigen3-dev
   # perception, simulation, collision
-  libpcl-dev libpcl-conversions-dev libopencv-dev python3-opencv libcv-bridge-dev python3-cv-bridge
+  libpcl-dev libpcl-conversions-dev libopencv-dev libopencv-contrib-dev python3-opencv
+  libcv-bridge-dev python3-cv-bridge  # contrib: ArUco markers (simulator, rascal calibrate)
   libode-dev libfcl-dev libyaml-cpp-dev
   # build and test
   build-essential cmake googletest libgtest-dev python3-venv python3-pytest python3-numpy python3-yaml
