@@ -71,8 +71,12 @@ TEST(Conversions, SherdPoseCarriesTheYawAboutZ) {
   d.yaw = 0.7;
   d.grasp.translation() = Eigen::Vector3d(0.2, 0.25, 0.015);
   d.outline = {Eigen::Vector3d(0.19, 0.24, 0.0), Eigen::Vector3d(0.21, 0.26, 0.0)};
+  d.height = 0.015;
+  d.support = 0.009;  // it lies on another sherd: its own height is height - support
   const rascal_msgs::Sherd s = conversions::toSherd(d, std_msgs::Header(), 3);
   EXPECT_EQ(s.id, 3u);
+  EXPECT_DOUBLE_EQ(s.height, 0.015);
+  EXPECT_DOUBLE_EQ(s.support, 0.009);
   EXPECT_DOUBLE_EQ(s.pose.position.x, 0.2);
   EXPECT_NEAR(2.0 * std::atan2(s.pose.orientation.z, s.pose.orientation.w), 0.7, 1e-12);
   EXPECT_DOUBLE_EQ(s.grasp_pose.position.z, 0.015);

@@ -413,3 +413,20 @@ def test_a_push_keeps_the_sherd_on_the_mat_and_moves_it_away_from_its_neighbours
     long = _obs(0.16, 0.25, 0.15, 0.04)
     d = push_direction(long, [long], area)
     assert d is None or abs(d[1]) < 1e-9
+
+
+def test_a_sherd_from_the_top_of_a_heap_is_recorded_with_its_own_height(data):
+    # It lay on another sherd whose top is 9 mm up; its own top 6 mm above that. The height as
+    # it lies (the archival photo's parallax) is its own, not the heap's.
+    cfg = config_from_dict(data)
+    batch = _batch(cfg)
+    batch.recorder = _Recorder()
+    on_top = rig.Observation(
+        0.12, 0.25, 0.0, 0.05, 0.04, 0.015, 0.12, 0.25, 0.0126, 0.0, 0.05, support=0.009
+    )
+    s = SherdRecord(batch, 1)
+    s.seen(on_top, batch.pickup)
+    s.record_dimensions(on_top)
+    call = batch.recorder.calls[0]  # ("dimensions", seq, length, width, thickness, height)
+    assert call[:2] == ("dimensions", 1) and call[5] == pytest.approx(0.006)
+    assert on_top.own_height == pytest.approx(0.006)

@@ -72,6 +72,7 @@ rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& head
   s.length = d.length;
   s.width = d.width;
   s.height = d.height;
+  s.support = d.support;
   s.thickness = d.thickness;
   s.covered = d.covered;
   s.grasp_clear = d.grasp_clear;

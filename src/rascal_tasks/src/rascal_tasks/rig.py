@@ -42,6 +42,12 @@ class Observation:
     vessel_diameter_sigma: float = 0.0  # its 1-sigma uncertainty
     covered: float = 0.0  # share of its outline under another sherd lying on it (a heap)
     grasp_clear: bool = True  # perception found a grasp whose fingers clear its neighbours
+    support: float = 0.0  # top of what it lies on above the station surface (a sherd in a heap)
+
+    @property
+    def own_height(self) -> float:
+        """Its height as it lies, from what it rests on (in a heap: not the sherd under it)."""
+        return max(self.height - self.support, 0.0)
 
     def distance_to(self, x: float, y: float) -> float:
         return math.hypot(self.x - x, self.y - y)

@@ -62,6 +62,7 @@ def observation_from_msg(s) -> rig.Observation:
         length=s.length,
         width=s.width,
         height=s.height,
+        support=s.support,
         thickness=s.thickness,
         covered=s.covered,
         grasp_clear=s.grasp_clear,
