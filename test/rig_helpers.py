@@ -54,7 +54,7 @@ def rascal(rig, *args, env=None):
         start_new_session=True,
         cwd=rig.ws,
     )
-    rig.procs.append(proc)
+    rig.clients.append(proc)
     return proc
 
 

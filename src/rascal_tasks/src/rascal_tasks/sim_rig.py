@@ -83,7 +83,8 @@ class SimRig:
         ws=None,
     ):
         self.ws = ws or workspace()
-        self.procs = []
+        self.procs = []  # the rig's nodes: one that exits while a service is awaited is a fault
+        self.clients = []  # `rascal` commands run against the rig: they exit by themselves
         self.own_log_dir = log_dir is None
         self.log_dir = log_dir or tempfile.mkdtemp(prefix="rascal_sim_rig_")
         self.logs = {}
@@ -92,7 +93,8 @@ class SimRig:
             self.master = RosMaster(log_dir=self.log_dir)
             self.env = self.master.env
         else:
-            self.env = dict(master_env)
+            # its own ROS_HOME: what its nodes keep there (the detector's backgrounds) is the rig's
+            self.env = dict(master_env, ROS_HOME=self.log_dir)
         try:
             self.run(["rosparam", "load", os.path.join(self.ws, "config", "rascal.yaml")])
             self.set_param("/use_sim_time", True)
@@ -184,12 +186,13 @@ class SimRig:
             cwd=self.ws,
             **popen,
         )
-        self.procs.append(proc)
+        self.clients.append(proc)
         return proc
 
     def stop(self):
-        for p in reversed(self.procs):
+        for p in reversed(self.clients + self.procs):
             stop(p)
+        self.clients = []
         self.procs = []
         if self.master is not None:
             self.master.stop()
