@@ -12,6 +12,9 @@ as a user types it (see test_batch_e2e.py).
 - arm_controller is killed mid-batch. The run must not wait for it for ever: it stops within
   30 s with exit code 3 and a line naming arm_controller; once it runs again, a rerun finishes
   the bag with each sherd once.
+- The run and the detector die together while a weighed sherd lies on the scale. The restarted
+  detector restores its backgrounds; the rerun finds that sherd on the scale and records each
+  sherd once.
 """
 
 import json
@@ -264,3 +267,38 @@ def test_a_killed_arm_controller_stops_the_run_in_bounded_time_and_a_rerun_finis
     restart(rig, "rascal_control", "arm_controller")
     rig.wait_for_service("/rascal/arm/compute_ik")
     rerun_finishes_once_each(rig, db, "FAULT-CTRL", truth)
+
+
+def test_a_restarted_detector_finds_the_sherd_a_killed_run_left_on_the_scale(
+    rig_factory, db, tmp_path
+):
+    """The run and the detector die together while a weighed sherd lies on the scale (a laptop
+    crash). The restarted detector restores the backgrounds it had learnt (BackgroundStore), so
+    the rerun's Calibrate sees the sherd on the scale and keeps the scale's model instead of
+    learning the sherd as background, and Resume carries on with it: each sherd recorded once.
+    Without the kept backgrounds that sherd was recorded lost and the next ones put on it."""
+    rig = rig_factory(archive=tmp_path / "archive", params={"/simulator/real_time_factor": 1.0})
+    truth = ground_truth(rig)
+    proc = rig.rascal("--dsn", db, "run", "--context", "FAULT-DET")
+    deadline = time.monotonic() + 400
+    while time.monotonic() < deadline and proc.poll() is None:
+        if any(r["status"] == "weighed" for r in rows(db, "FAULT-DET")):
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "batch ended before a sherd was weighed"
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    kill(rig, "sherd_detector")
+    restart(rig, "rascal_perception", "sherd_detector")
+    rig.wait_for_service("/rascal/perception/detect")
+    kept = os.path.join(rig.env["ROS_HOME"], "rascal", "backgrounds")
+    assert sorted(os.listdir(kept)) == [
+        "camera.yml.gz",
+        "discard.yml.gz",
+        "pickup.yml.gz",
+        "scale.yml.gz",
+    ], kept
+
+    out = rerun_finishes_once_each(rig, db, "FAULT-DET", truth)
+    assert "sherd(s) lying at the scale: its background model from before is kept" in out, out
+    assert "sherd 1 was weighed" in out, out[-3000:]

@@ -35,7 +35,7 @@ def start_rig(tmp_path, env, *sets, port="0"):
         args += ["--set", item]
     return subprocess.Popen(
         args,
-        env=env,
+        env=dict(env, ROS_HOME=str(tmp_path / "ros_home")),  # what the nodes keep stays the test's
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,

@@ -5,6 +5,7 @@
 // the fixtures (what the empty station shows that is not background: chart, scale bar).
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <opencv2/core/persistence.hpp>
 #include <vector>
 
 namespace rascal_perception {
@@ -53,6 +54,12 @@ class BackgroundModel {
   /// CV_8U 255 = fixture in the calibration image (not dilated).
   const cv::Mat& fixtureMask() const { return fixture_; }
   const BackgroundOptions& options() const { return options_; }
+
+  /// The learnt model as entries of an open map in `fs` (clusters, options, seen-map, fixtures).
+  void write(cv::FileStorage& fs) const;
+  /// The model `write` wrote; the tables rebuilt from it. Throws std::invalid_argument when an
+  /// entry is missing or out of range.
+  void read(const cv::FileNode& node);
 
  private:
   void cluster(const cv::Mat& hsv, const cv::Mat& ignore);

@@ -47,6 +47,11 @@ class SherdDetector {
   bool calibrated(const std::string& station) const { return stations_.count(station) > 0; }
   const BackgroundModel* model(const std::string& station) const;
   const PerceptionConfig& config() const { return config_; }
+  /// The station's background (model, calibration view, surface, fixtures) as entries of an open
+  /// map in `fs`; false when the station has none.
+  bool write(const std::string& station, cv::FileStorage& fs) const;
+  /// `station`'s background from what write() wrote. Throws std::invalid_argument.
+  void read(const std::string& station, const cv::FileNode& node);
 
  private:
   struct Station {

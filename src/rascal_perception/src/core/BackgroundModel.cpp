@@ -147,6 +147,59 @@ void BackgroundModel::cluster(const cv::Mat& hsv, const cv::Mat& ignore) {
   buildLut();
 }
 
+void BackgroundModel::write(cv::FileStorage& fs) const {
+  if (!ready()) throw std::logic_error("BackgroundModel::write: no model learnt");
+  fs << "options" << "{"
+     << "clusters" << options_.clusters << "hue_tolerance" << options_.hue_tolerance << "saturation_tolerance"
+     << options_.saturation_tolerance << "min_value" << options_.min_value << "min_cluster_fraction"
+     << options_.min_cluster_fraction << "grey_saturation" << options_.grey_saturation << "prior_dilation_px"
+     << options_.prior_dilation_px << "seed" << static_cast<int>(options_.seed) << "}";
+  fs << "clusters" << "[";
+  for (const BackgroundCluster& c : clusters_) {
+    fs << "{" << "hue" << c.hue << "saturation" << c.saturation << "value" << c.value << "fraction" << c.fraction
+       << "grey" << static_cast<int>(c.grey) << "}";
+  }
+  fs << "]";
+  fs << "seen" << seen_ << "fixture" << fixture_;
+}
+
+void BackgroundModel::read(const cv::FileNode& node) {
+  const cv::FileNode o = node["options"], cs = node["clusters"];
+  if (o.empty() || cs.empty() || !cs.isSeq() || cs.size() < 1 || cs.size() > 8) {
+    throw std::invalid_argument("background model: options or 1..8 clusters missing");
+  }
+  BackgroundOptions options;
+  options.clusters = static_cast<int>(o["clusters"]);
+  options.hue_tolerance = static_cast<double>(o["hue_tolerance"]);
+  options.saturation_tolerance = static_cast<double>(o["saturation_tolerance"]);
+  options.min_value = static_cast<double>(o["min_value"]);
+  options.min_cluster_fraction = static_cast<double>(o["min_cluster_fraction"]);
+  options.grey_saturation = static_cast<double>(o["grey_saturation"]);
+  options.prior_dilation_px = static_cast<int>(o["prior_dilation_px"]);
+  options.seed = static_cast<unsigned>(static_cast<int>(o["seed"]));
+  std::vector<BackgroundCluster> clusters;
+  for (const cv::FileNode c : cs) {
+    BackgroundCluster k;
+    k.hue = static_cast<double>(c["hue"]);
+    k.saturation = static_cast<double>(c["saturation"]);
+    k.value = static_cast<double>(c["value"]);
+    k.fraction = static_cast<double>(c["fraction"]);
+    k.grey = static_cast<int>(c["grey"]) != 0;
+    clusters.push_back(k);
+  }
+  cv::Mat seen, fixture;
+  node["seen"] >> seen;
+  node["fixture"] >> fixture;
+  if (seen.empty() || seen.type() != CV_8U || fixture.size() != seen.size() || fixture.type() != CV_8U) {
+    throw std::invalid_argument("background model: seen-map or fixture mask missing");
+  }
+  options_ = options;
+  clusters_ = clusters;
+  seen_ = seen;
+  fixture_ = fixture;
+  buildLut();
+}
+
 void BackgroundModel::buildLut() {
   lut_.assign(256 * 256, 0);
   for (int h = 0; h < 256; ++h) {

@@ -105,6 +105,53 @@ CalibrationResult SherdDetector::calibrate(const std::string& station, const cv:
   return r;
 }
 
+bool SherdDetector::write(const std::string& station, cv::FileStorage& fs) const {
+  auto it = stations_.find(station);
+  if (it == stations_.end()) return false;
+  const Station& s = it->second;
+  const CameraIntrinsics& k = s.view.intrinsics;
+  cv::Mat pose(4, 4, CV_64F);
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) pose.at<double>(r, c) = s.view.base_T_camera.matrix()(r, c);
+  }
+  fs << "view" << "{" << "width" << k.width << "height" << k.height << "fx" << k.fx << "fy" << k.fy << "cx" << k.cx
+     << "cy" << k.cy << "base_T_camera" << pose << "}";
+  fs << "surface_z" << s.surface_z << "station_fixture" << s.fixture;
+  fs << "model" << "{";
+  s.model.write(fs);
+  fs << "}";
+  return true;
+}
+
+void SherdDetector::read(const std::string& station, const cv::FileNode& node) {
+  const cv::FileNode v = node["view"];
+  cv::Mat pose, fixture;
+  if (!v.empty()) v["base_T_camera"] >> pose;
+  node["station_fixture"] >> fixture;
+  if (v.empty() || pose.rows != 4 || pose.cols != 4 || pose.type() != CV_64F || node["surface_z"].empty() ||
+      fixture.empty() || fixture.type() != CV_8U) {
+    throw std::invalid_argument("station " + station + ": view, surface_z or fixture mask missing");
+  }
+  Station s;
+  s.model.read(node["model"]);
+  if (fixture.size() != s.model.seenMap().size()) {
+    throw std::invalid_argument("station " + station + ": fixture mask and seen-map differ in size");
+  }
+  CameraIntrinsics& k = s.view.intrinsics;
+  k.width = static_cast<int>(v["width"]);
+  k.height = static_cast<int>(v["height"]);
+  k.fx = static_cast<double>(v["fx"]);
+  k.fy = static_cast<double>(v["fy"]);
+  k.cx = static_cast<double>(v["cx"]);
+  k.cy = static_cast<double>(v["cy"]);
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) s.view.base_T_camera.matrix()(r, c) = pose.at<double>(r, c);
+  }
+  s.surface_z = static_cast<double>(node["surface_z"]);
+  s.fixture = fixture;
+  stations_[station] = std::move(s);
+}
+
 CalibrationResult SherdDetector::refresh(const std::string& station, const cv::Mat& rgb, const cv::Mat& depth_mm,
                                          const CameraView& view, double surface_z) {
   CalibrationResult r;

@@ -3,7 +3,9 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
@@ -17,6 +19,21 @@ namespace {
 constexpr const char* kOpticalFrame = "camera_color_optical_frame";
 constexpr size_t kBuffer = 15;  ///< frames kept per stream (0.5 s at 30 Hz)
 constexpr double kPairSlop = 0.015;  ///< [s] colour and depth stamps closer than this are one frame
+/// [s] a kept background older than this is not restored at start-up: the light of another day
+constexpr double kRestoreWithin = 8 * 3600.0;
+
+/// Wall-clock seconds since the epoch: kept backgrounds outlive the simulator's clock.
+double wallNow() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+/// $ROS_HOME/rascal/backgrounds (ROS_HOME defaults to ~/.ros), where backgrounds are kept.
+std::string defaultBackgroundDir() {
+  const char* home = std::getenv("ROS_HOME");
+  if (home && *home) return std::string(home) + "/rascal/backgrounds";
+  const char* user = std::getenv("HOME");
+  return std::string(user && *user ? user : ".") + "/.ros/rascal/backgrounds";
+}
 
 /// The gripper from the URDF the rig runs (/robot_description), else rascal_description's.
 rascal_workcell::GripperGeometry gripperGeometry() {
@@ -31,9 +48,17 @@ rascal_workcell::GripperGeometry gripperGeometry() {
 }  // namespace
 
 SherdDetectorNode::SherdDetectorNode(ros::NodeHandle& root, ros::NodeHandle& private_nh) : tf_listener_(tf_buffer_) {
-  (void)private_nh;
   readParameters();
   detector_ = std::make_unique<SherdDetector>(params_.config);
+  // a restarted detector picks up the backgrounds it had learnt (see BackgroundStore)
+  store_ = std::make_unique<BackgroundStore>(private_nh.param("background_dir", defaultBackgroundDir()));
+  const double restore_within = private_nh.param("restore_within", kRestoreWithin);
+  for (const rascal_workcell::Station& st : params_.workcell.stations()) {
+    std::string message;
+    const bool restored = store_->restore(*detector_, st.name, wallNow(), restore_within, message);
+    if (restored) ROS_INFO_STREAM("sherd_detector: " << message);
+    else if (!message.empty()) ROS_WARN_STREAM("sherd_detector: " << message);
+  }
   colour_sub_ = root.subscribe("/camera/color/image_raw", 2, &SherdDetectorNode::onColour, this);
   depth_sub_ = root.subscribe("/camera/aligned_depth_to_color/image_raw", 2, &SherdDetectorNode::onDepth, this);
   info_sub_ = root.subscribe("/camera/color/camera_info", 1, &SherdDetectorNode::onInfo, this);
@@ -147,6 +172,15 @@ bool SherdDetectorNode::prepare(const Frame& frame, cv::Mat& rgb, cv::Mat& depth
   return true;
 }
 
+void SherdDetectorNode::keep(const std::string& station) {
+  try {
+    store_->save(*detector_, station, wallNow());
+  } catch (const std::exception& e) {
+    ROS_WARN_STREAM("sherd_detector: background of " << station << " not kept on disk (a restarted detector "
+                                                     << "must calibrate it again): " << e.what());
+  }
+}
+
 bool SherdDetectorNode::onCalibrate(rascal_msgs::CalibrateBackground::Request& req,
                                     rascal_msgs::CalibrateBackground::Response& res) {
   try {
@@ -166,7 +200,10 @@ bool SherdDetectorNode::onCalibrate(rascal_msgs::CalibrateBackground::Request& r
     }
     std::lock_guard<std::mutex> lock(detector_mutex_);
     const CalibrationResult r = detector_->calibrate(req.station, rgb, depth, view, station->surface_z);
-    if (r.success) refreshed_[req.station] = frame.colour->header.stamp;
+    if (r.success) {
+      refreshed_[req.station] = frame.colour->header.stamp;
+      keep(req.station);
+    }
     res.success = r.success;
     res.message = r.message;
     res.clusters = r.clusters;
@@ -206,7 +243,10 @@ bool SherdDetectorNode::onDetect(rascal_msgs::Detect::Request& req, rascal_msgs:
       const ros::Time stamp = frame.colour->header.stamp;
       if (r.success && params_.refresh_period > 0 && (stamp - refreshed_[req.station]).toSec() >= params_.refresh_period) {
         const CalibrationResult f = detector_->refresh(req.station, rgb, depth, view, station->surface_z);
-        if (f.success) refreshed_[req.station] = stamp;
+        if (f.success) {
+          refreshed_[req.station] = stamp;
+          keep(req.station);
+        }
         ROS_INFO_STREAM("sherd_detector: " << f.message);
       }
     }

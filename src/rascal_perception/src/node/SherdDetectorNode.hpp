@@ -15,6 +15,7 @@
 #include <mutex>
 #include <string>
 
+#include "rascal_perception/BackgroundStore.hpp"
 #include "rascal_perception/DetectorParameters.hpp"
 #include "rascal_perception/SherdDetector.hpp"
 
@@ -54,6 +55,10 @@ class SherdDetectorNode {
   sensor_msgs::CameraInfoConstPtr info_;
   std::mutex detector_mutex_;  ///< one service call at a time uses the detector
   std::unique_ptr<SherdDetector> detector_;
+  std::unique_ptr<BackgroundStore> store_;  ///< each station's background on disk
+  /// Gives the store the station's background just learnt (a failure only warns: the model in
+  /// memory serves this run). Called with detector_mutex_ held.
+  void keep(const std::string& station);
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
