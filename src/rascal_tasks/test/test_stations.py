@@ -160,6 +160,23 @@ def test_more_mass_than_one_sherd_of_its_size_can_have_is_two_sherds_put_back_on
     assert [n for n in _row(recorder).notes if n.startswith("mass checked: two sherds")]
 
 
+def test_a_pan_already_loaded_is_tared_over_and_the_row_says_so(station):
+    # a sherd left on the scale that the wrist camera did not see: the next sherd is weighed
+    # right (tared over it) and its row says the pan was not empty
+    plugin, sherd, scale, world, recorder, _ = station
+    scale.load = lambda t: 0.0207
+    plugin.before_place(sherd)
+    _place(world, scale)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)
+    (note,) = _notes(recorder, "pan_loaded")
+    assert "the empty pan read 20.7 g before the tare" in note, note
+    # the next sherd, on a pan emptied since (it reads below the tare): nothing said
+    scale.load = lambda t: 0.0
+    plugin.before_place(SherdRecord(plugin.batch, recorder.new_sherd((0.1, 0.2))))
+    assert not [n for n in recorder.sherds[2].notes if n.startswith("pan_loaded")]
+
+
 def test_unstable_longer_than_every_reread_is_mass_unstable_with_no_mass(station, config):
     plugin, sherd, scale, world, recorder, log = station
     plugin.before_place(sherd)

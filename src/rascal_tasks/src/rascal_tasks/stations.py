@@ -110,6 +110,7 @@ class ScaleStation(StationPlugin):
     def __init__(self, station, batch):
         super().__init__(station, batch)
         self._tared_for = None  # seq of the sherd the scale was tared (and checked) for
+        self._before_tare = 0.0  # kg, what the settled empty pan read before the last tare
 
     def _cfg(self):
         return self.batch.config["scale"]
@@ -163,6 +164,7 @@ class ScaleStation(StationPlugin):
         empty, last = self._settle(now - cfg["stable_window"] - 1.0)  # what it read till now too
         if empty is None:
             return "empty platform %s" % self._unsteady(last)
+        self._before_tare = empty.mass
         b.rig.scale.tare()
         zero, last = self._settle(b.rig.clock.now())
         if zero is None:
@@ -179,6 +181,16 @@ class ScaleStation(StationPlugin):
                 problem = self._tare_once()
                 if problem is None:
                     self._tared_for = sherd.seq
+                    if self._before_tare >= MIN_SHERD_MASS:
+                        # a sherd the wrist camera did not see there (or a zero that moved): the
+                        # tare takes it away, but the archaeologist is told, on this row
+                        b.event(
+                            sherd,
+                            "pan_loaded",
+                            "the empty pan read %.1f g before the tare for this sherd: something "
+                            "lies on the scale (or its zero moved); weighed tared over it"
+                            % (self._before_tare * 1000),
+                        )
                     return
                 b.event(sherd, "tare_failed", "attempt %d: %s" % (attempt + 1, problem))
         # Recorded before placing: a restart that finds it lying on the scale does not weigh it.
