@@ -7,21 +7,19 @@ arm controller and detector started with rosrun.
 
 import math
 import os
-import re
 
 import pytest
 import yaml
 from rig_helpers import SMALL, joint_positions
 
 from rascal_tasks import exit_codes
+from rascal_tasks.run_calibrate import Calibration
 
 pytestmark = pytest.mark.timeout(600)
 
 WORKSPACE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHIPPED = os.path.join(WORKSPACE, "config", "rascal.yaml")
 SLEEP = [0.0, -1.80, 1.55, 0.0, 0.8, 0.0]
-NUM = r"\s*([-\d.]+)"
-ROW = re.compile(r"^(\w+)\s+\(%s,%s\)\s+\(%s,%s\)%s mm%s°" % (NUM, NUM, NUM, NUM, NUM, NUM), re.M)
 
 
 def scenario_with(tmp_path, offsets):
@@ -41,10 +39,7 @@ def calibrate(rig, config, output, timeout=300):
 
 def measured(out):
     """station -> (x, y, turn rad) from the printed table."""
-    return {
-        m.group(1): (float(m.group(4)), float(m.group(5)), math.radians(float(m.group(7))))
-        for m in ROW.finditer(out)
-    }
+    return Calibration.parse_report(out)
 
 
 def shipped():

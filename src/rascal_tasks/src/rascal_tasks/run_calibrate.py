@@ -10,6 +10,7 @@ the corrected layout goes to its own file, checked by loading it like any config
 
 import math
 import os
+import re
 import sys
 
 import numpy as np
@@ -138,6 +139,18 @@ class Calibration:
             np.array([tr.x, tr.y, tr.z]),
         )
         return {marker_id: on_table}
+
+    # one row of report(): station (configured x, y) (measured x, y) shift mm turn° (residual)
+    _ROW = re.compile(r"^(\w+)\s+\(%s,%s\)\s+\(%s,%s\)%s mm%s°" % ((r"\s*([-\d.]+)",) * 6), re.M)
+
+    @classmethod
+    def parse_report(cls, out: str) -> dict:
+        """station -> (measured x [m], measured y [m], turn [rad]) from what report() printed
+        (benches and end-to-end tests read the command's output so)."""
+        return {
+            m.group(1): (float(m.group(4)), float(m.group(5)), math.radians(float(m.group(7))))
+            for m in cls._ROW.finditer(out)
+        }
 
     def report(self, poses):
         print(
