@@ -62,6 +62,19 @@ def rerun_finishes_once_each(rig, db, context, truth):
     return out
 
 
+def run_until_weighed(rig, db, context):
+    """`rascal run --context CONTEXT` started; returned, still running, as soon as its first sherd
+    is recorded weighed (the sherd then lies on the scale, or is being lifted off it)."""
+    proc = rig.rascal("--dsn", db, "run", "--context", context)
+    deadline = time.monotonic() + 400
+    while time.monotonic() < deadline and proc.poll() is None:
+        if any(r["status"] == "weighed" for r in rows(db, context)):
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the batch ended before a sherd was weighed"
+    return proc
+
+
 def node(rig, executable):
     return next(p for p in rig.procs if p.args[0] == "rosrun" and p.args[2] == executable)
 
@@ -239,13 +252,7 @@ def test_a_killed_arm_controller_stops_the_run_in_bounded_time_and_a_rerun_finis
 ):
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
-    proc = rig.rascal("--dsn", db, "run", "--context", "FAULT-CTRL")
-    deadline = time.monotonic() + 400
-    while time.monotonic() < deadline and proc.poll() is None:
-        if any(r["status"] == "weighed" for r in rows(db, "FAULT-CTRL")):
-            break
-        time.sleep(0.2)
-    assert proc.poll() is None, "batch ended before arm_controller could be killed"
+    proc = run_until_weighed(rig, db, "FAULT-CTRL")
     kill(rig, "arm_controller")
     t0 = time.monotonic()
     try:
@@ -279,13 +286,7 @@ def test_a_restarted_detector_finds_the_sherd_a_killed_run_left_on_the_scale(
     Without the kept backgrounds that sherd was recorded lost and the next ones put on it."""
     rig = rig_factory(archive=tmp_path / "archive", params={"/simulator/real_time_factor": 1.0})
     truth = ground_truth(rig)
-    proc = rig.rascal("--dsn", db, "run", "--context", "FAULT-DET")
-    deadline = time.monotonic() + 400
-    while time.monotonic() < deadline and proc.poll() is None:
-        if any(r["status"] == "weighed" for r in rows(db, "FAULT-DET")):
-            break
-        time.sleep(0.05)
-    assert proc.poll() is None, "batch ended before a sherd was weighed"
+    proc = run_until_weighed(rig, db, "FAULT-DET")
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     kill(rig, "sherd_detector")

@@ -114,9 +114,7 @@ int main(int argc, char** argv) {
     }
   }
   cv::setNumThreads(1);  // one core: no OpenCV worker threads competing for it
-  const DetectorParameters params =
-      DetectorParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sherd_detector"),
-                               rascal_workcell::GripperGeometry::fromPackageUrdf());
+  const DetectorParameters& params = rascal_perception_test::shippedDetector();
   const double surface_z = params.workcell.station(rascal_workcell::StationType::Pickup).surface_z;
   const int repeats = 5;
   std::vector<double> seg, det, seg_cpu, det_cpu;

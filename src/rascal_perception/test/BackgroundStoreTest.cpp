@@ -13,7 +13,6 @@
 
 #include "SimScenes.hpp"
 #include "rascal_perception/BackgroundStore.hpp"
-#include "rascal_perception/DetectorParameters.hpp"
 #include "rascal_perception/SherdDetector.hpp"
 
 using namespace rascal_perception;
@@ -22,12 +21,7 @@ using rascal_workcell::StationType;
 
 namespace {
 
-const PerceptionConfig& config() {
-  static const DetectorParameters p =
-      DetectorParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sherd_detector"),
-                               rascal_workcell::GripperGeometry::fromPackageUrdf());
-  return p.config;
-}
+const PerceptionConfig& config() { return shippedDetector().config; }
 
 /// A scratch folder, removed with what is in it.
 struct TempDir {

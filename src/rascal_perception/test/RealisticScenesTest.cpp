@@ -19,12 +19,7 @@ using rascal_workcell::StationType;
 
 namespace {
 
-const DetectorParameters& shipped() {
-  static const DetectorParameters p =
-      DetectorParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sherd_detector"),
-                               rascal_workcell::GripperGeometry::fromPackageUrdf());
-  return p;
-}
+const DetectorParameters& shipped() { return shippedDetector(); }
 
 struct Count {
   int expected = 0, found = 0, detections = 0, unmatched = 0;

@@ -25,13 +25,7 @@ using rascal_workcell::StationType;
 
 namespace {
 
-/// What the node reads: the shipped config/rascal.yaml and the package URDF's gripper.
-const DetectorParameters& shipped() {
-  static const DetectorParameters p =
-      DetectorParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sherd_detector"),
-                               rascal_workcell::GripperGeometry::fromPackageUrdf());
-  return p;
-}
+const DetectorParameters& shipped() { return shippedDetector(); }
 const PerceptionConfig& config() { return shipped().config; }
 double pickupZ() { return shipped().workcell.station(StationType::Pickup).surface_z; }
 

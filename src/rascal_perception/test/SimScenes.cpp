@@ -15,6 +15,13 @@ using namespace rascal_sim;
 
 namespace rascal_perception_test {
 
+const rascal_perception::DetectorParameters& shippedDetector() {
+  static const rascal_perception::DetectorParameters p = rascal_perception::DetectorParameters::read(
+      rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sherd_detector"),
+      rascal_workcell::GripperGeometry::fromPackageUrdf());
+  return p;
+}
+
 const SimParameters& simParameters() {
   static const SimParameters p =
       SimParameters::read(rascal_workcell::Parameters::fromFile(RASCAL_CONFIG_PATH, "sim"),

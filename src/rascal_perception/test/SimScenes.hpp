@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "rascal_perception/DetectorParameters.hpp"
 #include "rascal_perception/SherdMeasurer.hpp"
 #include "rascal_sim/ArmKinematics.hpp"
 #include "rascal_sim/Scenario.hpp"
@@ -35,6 +36,9 @@ struct Frame {
 
 /// Is the truth sherd entirely in the image, 5 px from its edges (so it must be found)?
 bool fullyInView(const Truth& t, const rascal_perception::CameraView& view);
+/// The detector as the node configures it: the shipped config/rascal.yaml and the package URDF's
+/// gripper (read once).
+const rascal_perception::DetectorParameters& shippedDetector();
 /// The simulator as the shipped config/rascal.yaml and the URDF set it up (read once).
 const rascal_sim::SimParameters& simParameters();
 const rascal_sim::WorldLayout& layout();
