@@ -114,6 +114,19 @@ def rows(dsn, context):
         return cur.fetchall()
 
 
+def run_until_weighed(rig, db, context, timeout=600):
+    """`rascal run --context CONTEXT` started; returned, still running, as soon as its first sherd
+    is recorded weighed (it then lies on the scale, or is being lifted off it)."""
+    proc = rig.rascal("--dsn", db, "run", "--context", context)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None:
+        if any(r["status"] == "weighed" for r in rows(db, context)):
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the batch ended before a sherd was weighed"
+    return proc
+
+
 def call(rig, code):
     """Run a few lines of rospy against the rig; returns what they print, as YAML."""
     return yaml.safe_load(rig.run(["/usr/bin/python3", "-c", code]).stdout)

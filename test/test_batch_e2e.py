@@ -9,7 +9,16 @@ import time
 
 import pytest
 import yaml
-from rig_helpers import SCENARIOS, SMALL, ground_truth, inject, joint_positions, rows, run_batch
+from rig_helpers import (
+    SCENARIOS,
+    SMALL,
+    ground_truth,
+    inject,
+    joint_positions,
+    rows,
+    run_batch,
+    run_until_weighed,
+)
 
 from rascal_tasks import exit_codes
 
@@ -130,13 +139,7 @@ def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
 
 def _interrupt_when_weighed(rig, db, context, sig):
     """Start a batch, and send `sig` to it once a sherd lies weighed (mid-batch)."""
-    proc = rig.rascal("--dsn", db, "run", "--context", context)
-    deadline = time.monotonic() + 600
-    while time.monotonic() < deadline and proc.poll() is None:
-        if any(r["status"] == "weighed" for r in rows(db, context)):
-            break
-        time.sleep(0.2)
-    assert proc.poll() is None, "batch ended before it could be interrupted"
+    proc = run_until_weighed(rig, db, context)
     if sig == signal.SIGKILL:
         os.killpg(proc.pid, signal.SIGKILL)  # no clean-up of any kind
     else:

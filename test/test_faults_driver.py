@@ -27,7 +27,7 @@ import time
 
 import pytest
 import yaml
-from rig_helpers import SMALL, WORKSPACE, ground_truth, rows, run_batch
+from rig_helpers import SMALL, WORKSPACE, ground_truth, rows, run_batch, run_until_weighed
 
 pytestmark = [pytest.mark.faults, pytest.mark.timeout(900)]
 
@@ -60,19 +60,6 @@ def rerun_finishes_once_each(rig, db, context, truth):
         assert abs(left[name][2] * 1000 - r["mass_g"]) < 0.2, (r["seq"], r["mass_g"], truth)
         del left[name]
     return out
-
-
-def run_until_weighed(rig, db, context):
-    """`rascal run --context CONTEXT` started; returned, still running, as soon as its first sherd
-    is recorded weighed (the sherd then lies on the scale, or is being lifted off it)."""
-    proc = rig.rascal("--dsn", db, "run", "--context", context)
-    deadline = time.monotonic() + 400
-    while time.monotonic() < deadline and proc.poll() is None:
-        if any(r["status"] == "weighed" for r in rows(db, context)):
-            break
-        time.sleep(0.05)
-    assert proc.poll() is None, "the batch ended before a sherd was weighed"
-    return proc
 
 
 def node(rig, executable):
