@@ -69,12 +69,12 @@ TEST(BackgroundStore, ARestoredBackgroundFindsWhatTheLearntOneFinds) {
   const BackgroundStore store(tmp.kept());
   SherdDetector learnt(config());
   ASSERT_TRUE(learnt.calibrate(s.name, s.empty.rgb, s.empty.depth, s.empty.view, s.surface).success);
-  store.save(learnt, s.name, 1000.0);
+  store.save(learnt, s.name, "here", 1000.0);
 
   SherdDetector restarted(config());
   ASSERT_FALSE(restarted.calibrated(s.name));
   std::string message;
-  ASSERT_TRUE(store.restore(restarted, s.name, 1000.0 + 60.0, 3600.0, message)) << message;
+  ASSERT_TRUE(store.restore(restarted, s.name, "here", 1000.0 + 60.0, 3600.0, message)) << message;
   EXPECT_NE(message.find("restored"), std::string::npos) << message;
   EXPECT_NE(message.find("60 s ago"), std::string::npos) << message;
   ASSERT_TRUE(restarted.calibrated(s.name));
@@ -100,31 +100,34 @@ TEST(BackgroundStore, AStaleForeignOrBrokenFileIsNotUsed) {
   std::string message;
 
   // none kept yet: nothing to say
-  EXPECT_FALSE(store.restore(d, s.name, 0.0, 3600.0, message));
+  EXPECT_FALSE(store.restore(d, s.name, "here", 0.0, 3600.0, message));
   EXPECT_EQ(message, "");
   // no model: nothing written
-  EXPECT_THROW(store.save(d, s.name, 0.0), std::invalid_argument);
+  EXPECT_THROW(store.save(d, s.name, "here", 0.0), std::invalid_argument);
 
-  store.save(learnt, s.name, 1000.0);
-  EXPECT_FALSE(store.restore(d, s.name, 1000.0 + 7200.0, 3600.0, message));
+  store.save(learnt, s.name, "here", 1000.0);
+  EXPECT_FALSE(store.restore(d, s.name, "here", 1000.0 + 7200.0, 3600.0, message));
   EXPECT_NE(message.find("7200 s ago (more than 3600 s): not used"), std::string::npos) << message;
-  EXPECT_FALSE(store.restore(d, s.name, 900.0, 3600.0, message));  // learnt "in the future": a clock set back
+  EXPECT_FALSE(store.restore(d, s.name, "here", 900.0, 3600.0, message));  // learnt "in the future": a clock set back
+  // the station moved since (rascal calibrate wrote a corrected layout)
+  EXPECT_FALSE(store.restore(d, s.name, "moved", 1000.0, 3600.0, message));
+  EXPECT_NE(message.find("before the layout changed: not used"), std::string::npos) << message;
   EXPECT_FALSE(d.calibrated(s.name));
 
   // another station's file under this name
   std::rename(store.path(s.name).c_str(), store.path("camera").c_str());
-  EXPECT_FALSE(store.restore(d, "camera", 1000.0, 3600.0, message));
+  EXPECT_FALSE(store.restore(d, "camera", "here", 1000.0, 3600.0, message));
   EXPECT_NE(message.find("another format or station"), std::string::npos) << message;
 
   // cut short (a full disk)
-  store.save(learnt, s.name, 1000.0);
+  store.save(learnt, s.name, "here", 1000.0);
   {
     std::ifstream in(store.path(s.name), std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::ofstream out(store.path(s.name), std::ios::binary | std::ios::trunc);
     out << bytes.substr(0, bytes.size() / 2);
   }
-  EXPECT_FALSE(store.restore(d, s.name, 1000.0, 3600.0, message));
+  EXPECT_FALSE(store.restore(d, s.name, "here", 1000.0, 3600.0, message));
   EXPECT_NE(message.find("not used"), std::string::npos) << message;
   EXPECT_FALSE(d.calibrated(s.name));
 

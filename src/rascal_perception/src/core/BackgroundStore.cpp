@@ -32,14 +32,15 @@ std::string BackgroundStore::path(const std::string& station) const {
   return dir_ + "/" + station + ".yml.gz";
 }
 
-void BackgroundStore::save(const SherdDetector& detector, const std::string& station, double learnt_at) const {
+void BackgroundStore::save(const SherdDetector& detector, const std::string& station, const std::string& layout,
+                           double learnt_at) const {
   const std::string file = path(station);
   const std::string partial = dir_ + "/." + station + ".partial.yml.gz";
   makeDirs(dir_);
   {
     cv::FileStorage fs(partial, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML | cv::FileStorage::BASE64);
     if (!fs.isOpened()) throw std::runtime_error("cannot write " + partial);
-    fs << "format" << kFormat << "station" << station << "learnt_at" << learnt_at;
+    fs << "format" << kFormat << "station" << station << "layout" << layout << "learnt_at" << learnt_at;
     if (!detector.write(station, fs)) {
       fs.release();
       std::remove(partial.c_str());
@@ -51,8 +52,8 @@ void BackgroundStore::save(const SherdDetector& detector, const std::string& sta
   }
 }
 
-bool BackgroundStore::restore(SherdDetector& detector, const std::string& station, double now, double max_age,
-                              std::string& message) const {
+bool BackgroundStore::restore(SherdDetector& detector, const std::string& station, const std::string& layout,
+                              double now, double max_age, std::string& message) const {
   const std::string file = path(station);
   message.clear();
   struct stat st;
@@ -63,6 +64,10 @@ bool BackgroundStore::restore(SherdDetector& detector, const std::string& statio
     if (!fs.isOpened()) throw std::invalid_argument("cannot be read");
     if (static_cast<int>(fs["format"]) != kFormat || static_cast<std::string>(fs["station"]) != station) {
       message = file + " is of another format or station: not used";
+      return false;
+    }
+    if (static_cast<std::string>(fs["layout"]) != layout) {  // moved (rascal calibrate) or re-measured
+      message = file + " was learnt where the station stood before the layout changed: not used";
       return false;
     }
     const double age = now - static_cast<double>(fs["learnt_at"]);

@@ -35,6 +35,19 @@ std::string defaultBackgroundDir() {
   return std::string(user && *user ? user : ".") + "/.ros/rascal/backgrounds";
 }
 
+/// What a station's kept background depends on: where the station and its fixtures are (a
+/// background learnt before `rascal calibrate` moved the station masks the wrong places).
+std::string layoutKey(const rascal_workcell::Station& s) {
+  std::ostringstream k;
+  k.precision(5);
+  k << std::fixed << static_cast<int>(s.type) << " " << s.surface_z << " " << s.wall_height << " " << s.stand_height;
+  for (const rascal_workcell::TableRect* r : {&s.area, &s.colour_chart, &s.scale_bar, &s.stand}) {
+    k << " " << r->centre.x() << " " << r->centre.y() << " " << r->size.x() << " " << r->size.y();
+  }
+  k << " " << s.place_at.x() << " " << s.place_at.y();
+  return k.str();
+}
+
 /// The gripper from the URDF the rig runs (/robot_description), else rascal_description's.
 rascal_workcell::GripperGeometry gripperGeometry() {
   std::string xml;
@@ -55,7 +68,7 @@ SherdDetectorNode::SherdDetectorNode(ros::NodeHandle& root, ros::NodeHandle& pri
   const double restore_within = private_nh.param("restore_within", kRestoreWithin);
   for (const rascal_workcell::Station& st : params_.workcell.stations()) {
     std::string message;
-    const bool restored = store_->restore(*detector_, st.name, wallNow(), restore_within, message);
+    const bool restored = store_->restore(*detector_, st.name, layoutKey(st), wallNow(), restore_within, message);
     if (restored) ROS_INFO_STREAM("sherd_detector: " << message);
     else if (!message.empty()) ROS_WARN_STREAM("sherd_detector: " << message);
   }
@@ -174,7 +187,9 @@ bool SherdDetectorNode::prepare(const Frame& frame, cv::Mat& rgb, cv::Mat& depth
 
 void SherdDetectorNode::keep(const std::string& station) {
   try {
-    store_->save(*detector_, station, wallNow());
+    std::string why;
+    const rascal_workcell::Station* s = findStation(station, why);
+    if (s) store_->save(*detector_, station, layoutKey(*s), wallNow());
   } catch (const std::exception& e) {
     ROS_WARN_STREAM("sherd_detector: background of " << station << " not kept on disk (a restarted detector "
                                                      << "must calibrate it again): " << e.what());
