@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "SimScenes.hpp"
@@ -61,14 +63,22 @@ const ScaleScene& scaleScene() {
   return s;
 }
 
+/// A detector that has learnt the empty scale of scaleScene().
+SherdDetector learntOnEmptyScale() {
+  const ScaleScene& s = scaleScene();
+  SherdDetector d(config());
+  const CalibrationResult c = d.calibrate(s.name, s.empty.rgb, s.empty.depth, s.empty.view, s.surface);
+  if (!c.success) throw std::runtime_error("calibration of the empty scale failed: " + c.message);
+  return d;
+}
+
 }  // namespace
 
 TEST(BackgroundStore, ARestoredBackgroundFindsWhatTheLearntOneFinds) {
   const ScaleScene& s = scaleScene();
   const TempDir tmp;
   const BackgroundStore store(tmp.kept());
-  SherdDetector learnt(config());
-  ASSERT_TRUE(learnt.calibrate(s.name, s.empty.rgb, s.empty.depth, s.empty.view, s.surface).success);
+  SherdDetector learnt = learntOnEmptyScale();
   store.save(learnt, s.name, "here", 1000.0);
 
   SherdDetector restarted(config());
@@ -94,8 +104,7 @@ TEST(BackgroundStore, AStaleForeignOrBrokenFileIsNotUsed) {
   const ScaleScene& s = scaleScene();
   const TempDir tmp;
   const BackgroundStore store(tmp.kept());
-  SherdDetector learnt(config());
-  ASSERT_TRUE(learnt.calibrate(s.name, s.empty.rgb, s.empty.depth, s.empty.view, s.surface).success);
+  const SherdDetector learnt = learntOnEmptyScale();
   SherdDetector d(config());
   std::string message;
 
@@ -132,4 +141,42 @@ TEST(BackgroundStore, AStaleForeignOrBrokenFileIsNotUsed) {
   EXPECT_FALSE(d.calibrated(s.name));
 
   EXPECT_THROW(store.path("../scale"), std::invalid_argument);
+}
+
+TEST(BackgroundStore, AFieldMissingFromAKeptBackgroundIsRefusedNotReadAsZero) {
+  // FileNode reads a missing number as 0: a focal length of 0 or a cluster's hue of 0 would
+  // make a wrong model without a word
+  const ScaleScene& s = scaleScene();
+  const SherdDetector learnt = learntOnEmptyScale();
+  cv::FileStorage out(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  ASSERT_TRUE(learnt.write(s.name, out));
+  const std::string whole = out.releaseAndGetString();
+  for (const std::string key : {"fx", "surface_z", "hue_tolerance", "saturation"}) {
+    std::string cut;
+    std::istringstream lines(whole);
+    bool dropped = false;
+    for (std::string line; std::getline(lines, line);) {
+      const size_t k = line.find_first_not_of(' ');
+      if (!dropped && k != std::string::npos && line.compare(k, key.size() + 1, key + ":") == 0) {
+        dropped = true;  // the first such field only
+        continue;
+      }
+      cut += line + "\n";
+    }
+    ASSERT_TRUE(dropped) << key;
+    cv::FileStorage in(cut, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+    SherdDetector d(config());
+    try {
+      d.read(s.name, in.root());
+      ADD_FAILURE() << "read without " << key;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(key + " missing"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(d.calibrated(s.name)) << key;
+  }
+  // and the whole file reads
+  cv::FileStorage in(whole, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  SherdDetector d(config());
+  d.read(s.name, in.root());
+  EXPECT_TRUE(d.calibrated(s.name));
 }

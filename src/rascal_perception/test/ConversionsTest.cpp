@@ -86,3 +86,20 @@ TEST(Conversions, SherdPoseCarriesTheYawAboutZ) {
   ASSERT_EQ(m.markers.size(), 5u);  // DELETEALL, box, arrow, fingers, label
   EXPECT_EQ(m.markers[0].action, visualization_msgs::Marker::DELETEALL);
 }
+
+TEST(Conversions, LeftoversAreDiscsSayingWhyTheyAreNotTaken) {
+  Leftover l;
+  l.position = Eigen::Vector3d(0.15, 0.3, 0.002);
+  l.length = 0.012;
+  l.width = 0.009;
+  l.why = "narrower than perception.min_sherd_size";
+  const rascal_msgs::Leftover msg = conversions::toLeftover(l);
+  EXPECT_DOUBLE_EQ(msg.position.y, 0.3);
+  EXPECT_DOUBLE_EQ(msg.width, 0.009);
+  EXPECT_EQ(msg.why, l.why);
+  const visualization_msgs::MarkerArray m = conversions::markers({}, std_msgs::Header(), {l});
+  ASSERT_EQ(m.markers.size(), 3u);  // DELETEALL, disc, label
+  EXPECT_EQ(m.markers[1].ns, "leftovers");
+  EXPECT_DOUBLE_EQ(m.markers[1].scale.x, 0.012);
+  EXPECT_NE(m.markers[2].text.find("min_sherd_size"), std::string::npos);
+}

@@ -4,7 +4,8 @@ name; not a conftest).
 `World` holds sherds lying on the stations of the config. The arm moves at once (1 s of the
 fake clock per move) unless `refuse(x, y, z, yaw, linear)` returns a RigError code; the gripper
 holds the sherd under the fingertips when it closes low enough and sets it down (or drops it)
-where it opens; the wrist camera sees the sherds of a station within 0.15 m of it; the scale
+where it opens; the wrist camera sees the sherds of a station within 0.15 m of it (and, like
+the detector, offers none narrower than perception.min_sherd_size, but says it); the scale
 weighs what lies on it. `Recorder` keeps the catalogue's status rules in memory.
 """
 
@@ -160,9 +161,23 @@ class _Perception(rig.Perception):
     def calibrate(self, station):
         self.calibrated.append(station)
 
-    def detect(self, station):
+    def _in_view(self, station):
         x, y, _, yaw = self.w.at
         cx, cy = x + CAMERA_OFFSET * math.cos(yaw), y + CAMERA_OFFSET * math.sin(yaw)
+        return [s for s in self.w.lying(station) if math.hypot(s.x - cx, s.y - cy) < VIEW_RADIUS]
+
+    def _pickable(self, s):
+        return s.width >= self.w.config["perception"]["min_sherd_size"]
+
+    def leftovers(self, station):
+        """Like the detector: what is narrower than min_sherd_size is said, not offered."""
+        return [
+            rig.Leftover(s.x, s.y, s.length, s.width, "narrower than perception.min_sherd_size")
+            for s in self._in_view(station)
+            if not self._pickable(s)
+        ]
+
+    def detect(self, station):
         surface = self.w.config.stations[station].surface_z
         return [
             rig.Observation(
@@ -179,8 +194,8 @@ class _Perception(rig.Perception):
                 s.width + 0.012,
                 thickness=s.thickness,
             )
-            for s in self.w.lying(station)
-            if math.hypot(s.x - cx, s.y - cy) < VIEW_RADIUS
+            for s in self._in_view(station)
+            if self._pickable(s)
         ]
 
     def detect_if_calibrated(self, station):

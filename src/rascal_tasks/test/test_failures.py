@@ -13,7 +13,9 @@ from rascal_tasks.catalogue.errors import CatalogueError
 from rascal_tasks.config import config_from_dict
 from rascal_tasks.failures import LOSE_SHERD, STOP, SherdFailure, classify
 from rascal_tasks.rig import RigError
+from rascal_tasks.run_batch import what_is_left
 from rascal_tasks.stations import DiscardStation
+from rascal_tasks.survey import describe_leftover
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
@@ -117,6 +119,18 @@ def test_an_unreachable_sherd_in_the_pickup_area_is_left_unnumbered(config):
     assert rec.status() == {1: "done"}  # b: a never had a number
     assert rec.sherds[1].pickup_xy == (0.25, 0.30)
     assert batch.unpickable == [(0.10, 0.22)]
+
+
+def test_a_chip_too_small_to_pick_is_left_and_said_not_finished_silently(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("chip", 0.25, 0.30, 0.012, 0.009)])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done"}  # the chip was never offered: no row
+    assert [(lo.x, lo.y) for lo in batch.leftovers] == [(0.25, 0.30)]  # once, from many views
+    left = what_is_left(batch, [])
+    assert "1 object on the pickup mat not taken as sherds" in left
+    assert "min_sherd_size" in describe_leftover(batch.leftovers[0])
+    assert "12 x 9 mm at (0.250, 0.300) m" in describe_leftover(batch.leftovers[0])
 
 
 def test_an_arm_timeout_parks_and_stops_with_nothing_else_recorded(config):

@@ -25,6 +25,9 @@ struct SegmentationStats {
   int rejected_border = 0, rejected_size = 0, splits = 0;
 };
 
+/// What the border and size checks say of one blob.
+enum class BlobCheck { kAccepted, kCutByBorder, kTooSmall, kTooLarge };
+
 class SherdSegmenter {
  public:
   /// Foreground = not background (per `allowed`, see BackgroundModel::classify) and not `fixture`,
@@ -36,7 +39,9 @@ class SherdSegmenter {
   /// Blobs of a binary mask (no colour model): contours, border and size checks, splitting.
   std::vector<Blob> blobs(const cv::Mat& mask, const SegmentationOptions& options,
                           SegmentationStats* stats = nullptr) const;
-  /// The border and size checks of one blob (counted in `stats` when it fails one).
+  /// The border and size checks of one blob.
+  static BlobCheck check(const Blob& blob, const cv::Size& image, const SegmentationOptions& options);
+  /// check() == kAccepted; a failure is counted in `stats`.
   static bool accept(const Blob& blob, const cv::Size& image, const SegmentationOptions& options,
                      SegmentationStats& stats);
   /// Splits one filled blob mask at its necks; returns 1 mask if it is one sherd.

@@ -79,6 +79,15 @@ struct SherdDetection {
   std::vector<cv::Point> contour;        ///< image contour (for drawing)
 };
 
+/// Something on the station that is not offered as a sherd to pick: too small or too large by
+/// perception.min/max_sherd_size, or not measurable. Said to the task layer so a batch that
+/// leaves it on the mat says so instead of finishing as if the mat were empty.
+struct Leftover {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m] centre of its outline, on the surface
+  double length = 0.0, width = 0.0;                   ///< [m] its image box on the surface (about)
+  std::string why;                                    ///< one line naming the rule
+};
+
 /// Result of a detection: the sherds by score, best first (ties in segmentation order), or why
 /// there are none. Which sherd is picked is the task layer's choice (perception.selection_policy).
 struct DetectionResult {
@@ -88,6 +97,7 @@ struct DetectionResult {
   Eigen::Vector4d plane = Eigen::Vector4d(0, 0, 1, 0);  ///< table plane in base_link, n.p + d = 0
   int plane_inliers = 0;
   int rejected_border = 0, rejected_size = 0, splits = 0;
+  std::vector<Leftover> leftovers;  ///< with depth only: what was seen whole but not offered
 };
 
 }  // namespace rascal_perception

@@ -5,6 +5,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "StoredFields.hpp"
+
 namespace rascal_perception {
 
 namespace {
@@ -168,23 +170,24 @@ void BackgroundModel::read(const cv::FileNode& node) {
   if (o.empty() || cs.empty() || !cs.isSeq() || cs.size() < 1 || cs.size() > 8) {
     throw std::invalid_argument("background model: options or 1..8 clusters missing");
   }
+  const std::string where = "background model";
   BackgroundOptions options;
-  options.clusters = static_cast<int>(o["clusters"]);
-  options.hue_tolerance = static_cast<double>(o["hue_tolerance"]);
-  options.saturation_tolerance = static_cast<double>(o["saturation_tolerance"]);
-  options.min_value = static_cast<double>(o["min_value"]);
-  options.min_cluster_fraction = static_cast<double>(o["min_cluster_fraction"]);
-  options.grey_saturation = static_cast<double>(o["grey_saturation"]);
-  options.prior_dilation_px = static_cast<int>(o["prior_dilation_px"]);
-  options.seed = static_cast<unsigned>(static_cast<int>(o["seed"]));
+  options.clusters = storedInt(o, "clusters", where);
+  options.hue_tolerance = storedNumber(o, "hue_tolerance", where);
+  options.saturation_tolerance = storedNumber(o, "saturation_tolerance", where);
+  options.min_value = storedNumber(o, "min_value", where);
+  options.min_cluster_fraction = storedNumber(o, "min_cluster_fraction", where);
+  options.grey_saturation = storedNumber(o, "grey_saturation", where);
+  options.prior_dilation_px = storedInt(o, "prior_dilation_px", where);
+  options.seed = static_cast<unsigned>(storedInt(o, "seed", where));
   std::vector<BackgroundCluster> clusters;
   for (const cv::FileNode c : cs) {
     BackgroundCluster k;
-    k.hue = static_cast<double>(c["hue"]);
-    k.saturation = static_cast<double>(c["saturation"]);
-    k.value = static_cast<double>(c["value"]);
-    k.fraction = static_cast<double>(c["fraction"]);
-    k.grey = static_cast<int>(c["grey"]) != 0;
+    k.hue = storedNumber(c, "hue", where + " cluster");
+    k.saturation = storedNumber(c, "saturation", where + " cluster");
+    k.value = storedNumber(c, "value", where + " cluster");
+    k.fraction = storedNumber(c, "fraction", where + " cluster");
+    k.grey = storedInt(c, "grey", where + " cluster") != 0;
     clusters.push_back(k);
   }
   cv::Mat seen, fixture;

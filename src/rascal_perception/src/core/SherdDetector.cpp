@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "StoredFields.hpp"
 
 namespace rascal_perception {
 
@@ -110,10 +113,8 @@ bool SherdDetector::write(const std::string& station, cv::FileStorage& fs) const
   if (it == stations_.end()) return false;
   const Station& s = it->second;
   const CameraIntrinsics& k = s.view.intrinsics;
-  cv::Mat pose(4, 4, CV_64F);
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) pose.at<double>(r, c) = s.view.base_T_camera.matrix()(r, c);
-  }
+  cv::Mat pose;
+  cv::eigen2cv(Eigen::Matrix4d(s.view.base_T_camera.matrix()), pose);
   fs << "view" << "{" << "width" << k.width << "height" << k.height << "fx" << k.fx << "fy" << k.fy << "cx" << k.cx
      << "cy" << k.cy << "base_T_camera" << pose << "}";
   fs << "surface_z" << s.surface_z << "station_fixture" << s.fixture;
@@ -124,30 +125,31 @@ bool SherdDetector::write(const std::string& station, cv::FileStorage& fs) const
 }
 
 void SherdDetector::read(const std::string& station, const cv::FileNode& node) {
+  const std::string where = "station " + station;
   const cv::FileNode v = node["view"];
   cv::Mat pose, fixture;
   if (!v.empty()) v["base_T_camera"] >> pose;
   node["station_fixture"] >> fixture;
-  if (v.empty() || pose.rows != 4 || pose.cols != 4 || pose.type() != CV_64F || node["surface_z"].empty() ||
-      fixture.empty() || fixture.type() != CV_8U) {
-    throw std::invalid_argument("station " + station + ": view, surface_z or fixture mask missing");
+  if (v.empty() || pose.rows != 4 || pose.cols != 4 || pose.type() != CV_64F || fixture.empty() ||
+      fixture.type() != CV_8U) {
+    throw std::invalid_argument(where + ": view or fixture mask missing");
   }
   Station s;
+  CameraIntrinsics& k = s.view.intrinsics;
+  k.width = storedInt(v, "width", where + " view");
+  k.height = storedInt(v, "height", where + " view");
+  k.fx = storedNumber(v, "fx", where + " view");
+  k.fy = storedNumber(v, "fy", where + " view");
+  k.cx = storedNumber(v, "cx", where + " view");
+  k.cy = storedNumber(v, "cy", where + " view");
+  Eigen::Matrix4d m;
+  cv::cv2eigen(pose, m);
+  s.view.base_T_camera.matrix() = m;
+  s.surface_z = storedNumber(node, "surface_z", where);
   s.model.read(node["model"]);
   if (fixture.size() != s.model.seenMap().size()) {
-    throw std::invalid_argument("station " + station + ": fixture mask and seen-map differ in size");
+    throw std::invalid_argument(where + ": fixture mask and seen-map differ in size");
   }
-  CameraIntrinsics& k = s.view.intrinsics;
-  k.width = static_cast<int>(v["width"]);
-  k.height = static_cast<int>(v["height"]);
-  k.fx = static_cast<double>(v["fx"]);
-  k.fy = static_cast<double>(v["fy"]);
-  k.cx = static_cast<double>(v["cx"]);
-  k.cy = static_cast<double>(v["cy"]);
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) s.view.base_T_camera.matrix()(r, c) = pose.at<double>(r, c);
-  }
-  s.surface_z = static_cast<double>(node["surface_z"]);
   s.fixture = fixture;
   stations_[station] = std::move(s);
 }
@@ -265,15 +267,38 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
   StackOptions stack;
   const double ppm = pixelsPerMetre(view, surface_z);
   stack.min_area_px = static_cast<int>(0.5 * std::pow(config_.min_sherd_size * ppm, 2));
+  // something seen whole but not offered: where it lies and why, for the task layer to say
+  auto leave = [&](const Blob& b, const std::string& why) {
+    Leftover l;
+    l.why = why;
+    l.length = std::max(b.box.size.width, b.box.size.height) / ppm;
+    l.width = std::min(b.box.size.width, b.box.size.height) / ppm;
+    if (SherdMeasurer::intersect(view, r.plane, 0.0, b.box.center.x, b.box.center.y, l.position)) {
+      r.leftovers.push_back(std::move(l));
+    }
+  };
   for (const Blob& b : blobs) {
     const std::vector<StackPart> parts = stacks_.split(b, height, stack);
     r.splits += static_cast<int>(parts.size()) - 1;
     for (const StackPart& part : parts) {
-      if (!depth_mm.empty() && !SherdSegmenter::accept(part.blob, rgb.size(), checks, stats)) continue;
+      if (!depth_mm.empty()) {
+        const BlobCheck verdict = SherdSegmenter::check(part.blob, rgb.size(), checks);
+        if (verdict == BlobCheck::kCutByBorder) {  // another view of the survey sees it whole
+          ++stats.rejected_border;
+          continue;
+        }
+        if (verdict != BlobCheck::kAccepted) {
+          ++stats.rejected_size;
+          leave(part.blob, verdict == BlobCheck::kTooSmall ? "narrower than perception.min_sherd_size"
+                                                           : "longer than perception.max_sherd_size");
+          continue;
+        }
+      }
       SherdDetection d;
       std::string why;
       if (!measurer_.measure(part.blob, rgb, depth_mm, view, r.plane, d, why)) {
         ++r.rejected_size;
+        if (!depth_mm.empty()) leave(part.blob, why);
         continue;
       }
       d.covered = part.covered;

@@ -92,21 +92,29 @@ std::vector<Blob> SherdSegmenter::blobs(const cv::Mat& mask, const SegmentationO
   return out;
 }
 
-bool SherdSegmenter::accept(const Blob& b, const cv::Size& image, const SegmentationOptions& options,
-                            SegmentationStats& st) {
+BlobCheck SherdSegmenter::check(const Blob& b, const cv::Size& image, const SegmentationOptions& options) {
   const int m = options.border_margin;
   const cv::Rect& r = b.bounds;
   if (r.x < m || r.y < m || r.x + r.width > image.width - m || r.y + r.height > image.height - m) {
-    ++st.rejected_border;
-    return false;
+    return BlobCheck::kCutByBorder;
   }
-  const double lo = std::min(b.box.size.width, b.box.size.height);
-  const double hi = std::max(b.box.size.width, b.box.size.height);
-  if (lo < options.min_side_px || hi > options.max_side_px) {
-    ++st.rejected_size;
-    return false;
+  if (std::min(b.box.size.width, b.box.size.height) < options.min_side_px) return BlobCheck::kTooSmall;
+  if (std::max(b.box.size.width, b.box.size.height) > options.max_side_px) return BlobCheck::kTooLarge;
+  return BlobCheck::kAccepted;
+}
+
+bool SherdSegmenter::accept(const Blob& b, const cv::Size& image, const SegmentationOptions& options,
+                            SegmentationStats& st) {
+  switch (check(b, image, options)) {
+    case BlobCheck::kAccepted:
+      return true;
+    case BlobCheck::kCutByBorder:
+      ++st.rejected_border;
+      return false;
+    default:
+      ++st.rejected_size;
+      return false;
   }
-  return true;
 }
 
 std::vector<cv::Mat> SherdSegmenter::split(const cv::Mat& mask, double min_neck, double min_peak_px) const {

@@ -91,7 +91,17 @@ rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& head
   return s;
 }
 
-visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherds, const std_msgs::Header& header) {
+rascal_msgs::Leftover toLeftover(const Leftover& l) {
+  rascal_msgs::Leftover m;
+  m.position = tf2::toMsg(l.position);
+  m.length = l.length;
+  m.width = l.width;
+  m.why = l.why;
+  return m;
+}
+
+visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherds, const std_msgs::Header& header,
+                                        const std::vector<Leftover>& leftovers) {
   visualization_msgs::MarkerArray a;
   visualization_msgs::Marker clear;
   clear.header = header;
@@ -164,6 +174,32 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
     std::snprintf(buf, sizeof(buf), "#%zu %.0fx%.0f mm, wall %.1f mm%s%s", i, d.length * 1e3, d.width * 1e3,
                   d.thickness * 1e3, under ? ", under another" : "", d.grasp_clear ? "" : ", fingers blocked");
     text.text = buf;
+    a.markers.push_back(text);
+  }
+  for (size_t i = 0; i < leftovers.size(); ++i) {
+    const Leftover& l = leftovers[i];
+    visualization_msgs::Marker disc;
+    disc.header = header;
+    disc.ns = "leftovers";
+    disc.id = static_cast<int>(i);
+    disc.type = visualization_msgs::Marker::CYLINDER;
+    disc.action = visualization_msgs::Marker::ADD;
+    disc.pose.position = tf2::toMsg(l.position);
+    disc.pose.orientation.w = 1.0;
+    disc.scale.x = disc.scale.y = std::max(l.length, 0.005);
+    disc.scale.z = 0.002;
+    disc.color.r = 1.0f;
+    disc.color.g = 0.85f;
+    disc.color.b = 0.0f;
+    disc.color.a = 0.8f;
+    a.markers.push_back(disc);
+    visualization_msgs::Marker text = disc;
+    text.ns = "leftover_labels";
+    text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+    text.pose.position.z += 0.02;
+    text.scale.z = 0.012;
+    text.color.r = text.color.g = text.color.b = text.color.a = 1.0f;
+    text.text = "not taken: " + l.why;
     a.markers.push_back(text);
   }
   return a;

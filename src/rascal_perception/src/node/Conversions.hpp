@@ -2,6 +2,7 @@
 // Stateless conversions between ROS messages and the perception core's types (one place):
 // images through cv_bridge, poses and transforms through tf2_eigen; what no library has (the
 // camera intrinsics, the Sherd message, the markers) written here.
+#include <rascal_msgs/Leftover.h>
 #include <rascal_msgs/Sherd.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -29,8 +30,11 @@ sensor_msgs::Image toImage(const cv::Mat& rgb, const std_msgs::Header& header);
 /// K of the colour stream; throws std::invalid_argument without a focal length.
 CameraIntrinsics intrinsics(const sensor_msgs::CameraInfo& info);
 rascal_msgs::Sherd toSherd(const SherdDetection& d, const std_msgs::Header& header, uint32_t id);
-/// Oriented boxes, grasp arrows and labels (namespace per kind), after a DELETEALL.
-visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherds, const std_msgs::Header& header);
+rascal_msgs::Leftover toLeftover(const Leftover& l);
+/// Oriented boxes, grasp arrows and labels (namespace per kind), after a DELETEALL; leftovers as
+/// flat yellow discs labelled with why they are not offered.
+visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherds, const std_msgs::Header& header,
+                                        const std::vector<Leftover>& leftovers = {});
 
 }  // namespace conversions
 }  // namespace rascal_perception

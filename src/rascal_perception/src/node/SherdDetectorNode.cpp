@@ -185,14 +185,12 @@ bool SherdDetectorNode::prepare(const Frame& frame, cv::Mat& rgb, cv::Mat& depth
   return true;
 }
 
-void SherdDetectorNode::keep(const std::string& station) {
+void SherdDetectorNode::keep(const rascal_workcell::Station& station) {
   try {
-    std::string why;
-    const rascal_workcell::Station* s = findStation(station, why);
-    if (s) store_->save(*detector_, station, layoutKey(*s), wallNow());
+    store_->save(*detector_, station.name, layoutKey(station), wallNow());
   } catch (const std::exception& e) {
-    ROS_WARN_STREAM("sherd_detector: background of " << station << " not kept on disk (a restarted detector "
-                                                     << "must calibrate it again): " << e.what());
+    ROS_WARN_STREAM("sherd_detector: background of " << station.name << " not kept on disk (a restarted "
+                                                     << "detector must calibrate it again): " << e.what());
   }
 }
 
@@ -217,7 +215,7 @@ bool SherdDetectorNode::onCalibrate(rascal_msgs::CalibrateBackground::Request& r
     const CalibrationResult r = detector_->calibrate(req.station, rgb, depth, view, station->surface_z);
     if (r.success) {
       refreshed_[req.station] = frame.colour->header.stamp;
-      keep(req.station);
+      keep(*station);
     }
     res.success = r.success;
     res.message = r.message;
@@ -260,7 +258,7 @@ bool SherdDetectorNode::onDetect(rascal_msgs::Detect::Request& req, rascal_msgs:
         const CalibrationResult f = detector_->refresh(req.station, rgb, depth, view, station->surface_z);
         if (f.success) {
           refreshed_[req.station] = stamp;
-          keep(req.station);
+          keep(*station);
         }
         ROS_INFO_STREAM("sherd_detector: " << f.message);
       }
@@ -274,7 +272,8 @@ bool SherdDetectorNode::onDetect(rascal_msgs::Detect::Request& req, rascal_msgs:
     for (size_t i = 0; i < r.sherds.size(); ++i) {
       res.detections.sherds.push_back(conversions::toSherd(r.sherds[i], header, static_cast<uint32_t>(i)));
     }
-    markers_pub_.publish(conversions::markers(r.sherds, header));
+    for (const Leftover& l : r.leftovers) res.leftovers.push_back(conversions::toLeftover(l));
+    markers_pub_.publish(conversions::markers(r.sherds, header, r.leftovers));
     if (annotated_pub_.getNumSubscribers() > 0 || annotated_pub_.isLatched()) {
       std_msgs::Header image_header = frame.colour->header;
       annotated_pub_.publish(conversions::toImage(Annotator::draw(rgb, r.sherds, cv::Mat(), &view), image_header));

@@ -58,7 +58,7 @@ class SherdDetectorNode {
   std::unique_ptr<BackgroundStore> store_;  ///< each station's background on disk
   /// Gives the store the station's background just learnt (a failure only warns: the model in
   /// memory serves this run). Called with detector_mutex_ held.
-  void keep(const std::string& station);
+  void keep(const rascal_workcell::Station& station);
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

@@ -18,6 +18,9 @@ class SensorEffects {
   static constexpr double kMinDepth = 0.105;       ///< [m] below this the D435 returns 0 (min-Z)
 
   explicit SensorEffects(unsigned seed = 1);
+  /// Starts the noise over from `seed` (the table of samples stays; where it is read from is
+  /// drawn again): the same scene loaded twice gives the same frames.
+  void reseed(unsigned seed) { rng_.seed(seed); }
   /// White-balance gains of light at `kelvin` relative to 6500 K (sRGB primaries).
   static Eigen::Vector3d temperatureGains(double kelvin);
   /// sigma of the depth noise at distance z [m].

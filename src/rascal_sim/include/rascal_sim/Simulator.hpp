@@ -131,6 +131,7 @@ class Simulator {
   ScaleSensor scale_;
   ArchivalCamera archival_;
   Renderer renderer_;
+  static constexpr unsigned kSensorSeed = 11;  ///< the camera noise starts here at every load()
   SensorEffects effects_;
   SurfaceRealism realism_;  ///< loaded with the first scenario that asks for it
   Scenario scenario_;

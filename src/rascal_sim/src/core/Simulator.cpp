@@ -36,7 +36,7 @@ Simulator::Simulator(const WorldLayout& layout, const SimulatorOptions& options)
       gripper_(options.gripper, options.initial_finger),
       scale_(7),
       archival_(layout, options.archival_width, options.archival_height),
-      effects_(11),
+      effects_(kSensorSeed),
       rng_(1) {
   world_->placeArm(servos_.positions(), gripper_.position());
 }
@@ -48,6 +48,9 @@ void Simulator::load(const Scenario& scenario) {
   world_->seedSolver(scenario.seed);
   scenario_ = scenario;
   rng_.seed(scenario.seed);
+  // the frames of a scenario do not depend on what was rendered before it was loaded (tests
+  // render many scenes in one simulator, in any order)
+  effects_.reseed(kSensorSeed);
   slip_armed_ = false;
   close_armed_ = false;
   open_requested_ = false;

@@ -56,6 +56,8 @@ class Batch:
             None  # put back as two: its number goes to the next pick
         )
         self.seen: List[Observation] = []  # the last survey of the pickup area, merged
+        # what the last survey saw on the mat but perception did not offer (rig.Leftover)
+        self.leftovers: List = []
         self.empty_surveys = 0
         self.stop_reason: Optional[str] = None  # detail of the last STOPPING_EVENTS event
         self.park_failed = False  # workflow.Park could not park the arm

@@ -54,6 +54,21 @@ class Observation:
 
 
 @dataclass
+class Leftover:
+    """Something perception saw whole at a station but does not offer as a sherd to pick (too
+    small or too large by perception.min/max_sherd_size, or not measurable), in base_link."""
+
+    x: float
+    y: float
+    length: float  # [m] about: from the image
+    width: float
+    why: str  # one line naming the rule
+
+    def distance_to(self, x: float, y: float) -> float:
+        return math.hypot(self.x - x, self.y - y)
+
+
+@dataclass
 class ScaleReading:
     mass: float  # kg, tared, as the scale shows it
     stable: bool  # the scale's own stability flag (stations.ScaleStation does not trust it alone)
@@ -149,6 +164,10 @@ class Perception:
     def detect_if_calibrated(self, station: str) -> Optional[List[Observation]]:
         """Like detect, but None at once if the station has no background model yet."""
         raise NotImplementedError
+
+    def leftovers(self, station: str) -> List[Leftover]:
+        """What the last detect at `station` saw there but did not offer as sherds."""
+        return []
 
 
 class Scale:

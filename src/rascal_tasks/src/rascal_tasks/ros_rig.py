@@ -78,6 +78,11 @@ def observation_from_msg(s) -> rig.Observation:
     )
 
 
+def leftover_from_msg(m) -> rig.Leftover:
+    """rascal_msgs/Leftover -> Leftover (both in base_link)."""
+    return rig.Leftover(m.position.x, m.position.y, m.length, m.width, m.why)
+
+
 def _proxy(name, srv_type):
     try:
         rospy.wait_for_service(name, timeout=SERVICE_WAIT)
@@ -290,6 +295,7 @@ class RosPerception(rig.Perception):
         self._stop = stop
         self._detect = _proxy("/rascal/perception/detect", Detect)
         self._calibrate = _proxy("/rascal/perception/calibrate_background", CalibrateBackground)
+        self._leftovers = {}  # station -> what its last detect saw but did not offer
 
     def _call(self, proxy, station, what, none_if=None):
         """The successful response; None as soon as a failure's message holds `none_if`."""
@@ -323,7 +329,11 @@ class RosPerception(rig.Perception):
 
     def detect(self, station):
         res = self._call(self._detect, station, "DETECT")
+        self._leftovers[station] = [leftover_from_msg(m) for m in res.leftovers]
         return [observation_from_msg(s) for s in res.detections.sherds]
+
+    def leftovers(self, station):
+        return list(self._leftovers.get(station, []))
 
     def detect_if_calibrated(self, station):
         # Any attempt may be the one that says 'no background model': the detector waits for a
@@ -331,7 +341,10 @@ class RosPerception(rig.Perception):
         # those (at start-up with the simulator at full speed, TF lags the images) says it on
         # the retry. (Retrying through detect() turned that answer into an error.)
         res = self._call(self._detect, station, "DETECT", none_if="no background model")
-        return None if res is None else [observation_from_msg(s) for s in res.detections.sherds]
+        if res is None:
+            return None
+        self._leftovers[station] = [leftover_from_msg(m) for m in res.leftovers]
+        return [observation_from_msg(s) for s in res.detections.sherds]
 
 
 class RosScale(rig.Scale):

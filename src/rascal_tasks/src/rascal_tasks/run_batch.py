@@ -35,6 +35,7 @@ from rascal_tasks.rig import Rig, RigError
 from rascal_tasks.ros_config import load_for_run
 from rascal_tasks.ros_graph import GraphError, check_master, run_needs, wait_for_nodes
 from rascal_tasks.run_lock import Busy, ContextLock, RigLock
+from rascal_tasks.survey import describe_leftover
 from rascal_tasks.workflow import Batch, build_machine, park, smach
 
 MASTER_TIMEOUT = 3.0  # s: a master that does not answer within this is not there
@@ -317,7 +318,12 @@ class Run:
                 self.context,
                 cfg["rig"]["name"],
                 "batch_ended",
-                {"exit": code, "outcome": outcome},
+                {
+                    "exit": code,
+                    "outcome": outcome,
+                    # what the person is told to look at stays with the context's history
+                    "not_taken": [describe_leftover(lo) for lo in done[-1].leftovers],
+                },
             )
         except psycopg2.Error as e:  # not logged: the next run resumes, which loses nothing
             rospy.logwarn("batch_ended not logged: %s", _first_line(e))
@@ -464,8 +470,9 @@ def make_rig(cfg, stop=None) -> Rig:
 
 def what_is_left(batch, rows) -> str:
     """What a person must see to after a finished batch ('' when the bag is complete): sherds
-    left on the mat, and rows of the context lost, without a mass (the scale gave none that
-    could be trusted: mass_unstable, or done with mass_missing_reason) or unfinished."""
+    left on the mat, objects on it perception does not offer as sherds, and rows of the context
+    lost, without a mass (the scale gave none that could be trusted: mass_unstable, or done with
+    mass_missing_reason) or unfinished."""
     rows = rows or []
     counts = (
         (len(batch.unpickable), "left on the pickup mat (could not be picked up)"),
@@ -476,7 +483,15 @@ def what_is_left(batch, rows) -> str:
         ),
         (sum(r["status"] not in ("done", "lost") for r in rows), "unfinished"),
     )
-    return ", ".join("%d sherd%s %s" % (n, "" if n == 1 else "s", what) for n, what in counts if n)
+    parts = ["%d sherd%s %s" % (n, "" if n == 1 else "s", what) for n, what in counts if n]
+    if batch.leftovers:  # perhaps not sherds at all: a chip, a pebble, a label
+        n = len(batch.leftovers)
+        parts.insert(
+            1,
+            "%d object%s on the pickup mat not taken as sherds (too small or too large: "
+            "listed above)" % (n, "" if n == 1 else "s"),
+        )
+    return ", ".join(parts)
 
 
 def print_summary(batches, rows, outcome, wall_seconds):
@@ -500,6 +515,8 @@ def print_summary(batches, rows, outcome, wall_seconds):
     )
     for x, y in batches[-1].unpickable:
         print("left in the pickup area (could not be picked up): sherd at (%.3f, %.3f) m" % (x, y))
+    for lo in batches[-1].leftovers:
+        print(describe_leftover(lo))
     state_times = {}
     for b in batches:
         for k, v in b.state_times.items():

@@ -59,6 +59,17 @@ def survey_at(b, station, x, y) -> List[Observation]:
         return b.rig.perception.detect(station.name)
 
 
+def describe_leftover(lo) -> str:
+    """One line for a person: what lies on the mat, where, and why it was not taken."""
+    return "%.0f x %.0f mm at (%.3f, %.3f) m left on the pickup mat, not taken: %s" % (
+        lo.length * 1000,
+        lo.width * 1000,
+        lo.x,
+        lo.y,
+        lo.why,
+    )
+
+
 def merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
     """Add to `found` the detections of `new` that are not a sherd already in it."""
     for o in new:
@@ -69,10 +80,26 @@ def merge(found: List[Observation], new: List[Observation]) -> List[Observation]
 
 def survey_pickup_area(b) -> List[Observation]:
     """The lawnmower over the pickup area, views merged. Sherds the gripper failed on
-    again and again are left out: they stay where they are, for a person."""
+    again and again are left out: they stay where they are, for a person. What the views saw
+    on the mat but perception does not offer as sherds (too small, too large) is kept in
+    `b.leftovers`, merged the same way: a batch that ends with them there says so."""
     found: List[Observation] = []
+    b.leftovers = []
     for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size, b.config["survey"]["step"]):
         merge(found, survey_at(b, b.pickup, x, y))
+        merge(
+            b.leftovers,
+            [
+                lo
+                for lo in b.rig.perception.leftovers(b.pickup.name)
+                if b.pickup.area.has((lo.x, lo.y))
+                and all(o.distance_to(lo.x, lo.y) > SAME_SHERD for o in found)
+            ],
+        )
+    # a sherd seen whole in a later view is not a leftover of an earlier one
+    b.leftovers = [
+        lo for lo in b.leftovers if all(o.distance_to(lo.x, lo.y) > SAME_SHERD for o in found)
+    ]
     return [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)]
 
 
@@ -92,6 +119,8 @@ class Survey(BatchState):
                 if b.renumber is not None:  # its number must not stay unfinished
                     b.sherd, b.renumber = b.renumber, None
                     b.sherd.lose("put back on the pickup mat as two sherds and not seen again")
+                for lo in b.leftovers:
+                    b.event(None, "not_taken", describe_leftover(lo))
                 return "empty"
             return self.run()
         b.empty_surveys = 0
