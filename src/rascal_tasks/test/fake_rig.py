@@ -49,6 +49,9 @@ class World:
         self.named: List[str] = []  # named poses gone to (park: "sleep")
         self.refuse = lambda x, y, z, yaw, linear: None
         self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
+        # sherd name -> where it falls when it slips out while lifted ((x, y), or None: off
+        # every station, on the table beside the mat)
+        self.lift_slips: Dict[str, Optional[tuple]] = {}
         self.camera_refusals = 0  # captures to refuse before one succeeds
         self.camera_refuses = lambda exposure_ev: False  # and any capture this says
         # photos written (into `photo_folder`) when set: a grey frame with a white patch of
@@ -140,6 +143,13 @@ class _Gripper(rig.Gripper):
     def holding(self):
         s = self.w.held
         x, y = self.w.at[:2]
+        if s is not None and s.name in self.w.lift_slips:
+            self.w.held = None  # slipped out while lifted
+            where = self.w.lift_slips.pop(s.name)
+            if where is None:
+                s.station = None
+            else:
+                self.w.put(s, *where)
         if (
             s is not None
             and s.name in self.w.slips

@@ -133,6 +133,27 @@ def test_a_chip_too_small_to_pick_is_left_and_said_not_finished_silently(config)
     assert "12 x 9 mm at (0.250, 0.300) m" in describe_leftover(batch.leftovers[0])
 
 
+def test_a_sherd_that_slips_out_while_lifted_and_vanishes_is_said(config):
+    # it had no number yet: without a look, the batch would end "complete" one sherd short
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.lift_slips["b"] = None  # falls off the mat
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done"}
+    assert batch.slipped_away == [(0.25, 0.30)]
+    assert "1 sherd slipped out of the fingers while lifted" in what_is_left(batch, [])
+
+
+def test_a_sherd_that_slips_out_while_lifted_and_falls_near_is_picked_again(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.lift_slips["b"] = (0.27, 0.31)
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert batch.slipped_away == [] and batch.lift_slips == [(0.25, 0.30)]
+    assert what_is_left(batch, []) == ""
+
+
 def test_an_arm_timeout_parks_and_stops_with_nothing_else_recorded(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
     scale = config.stations["scale"]

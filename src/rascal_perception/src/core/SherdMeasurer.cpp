@@ -219,7 +219,10 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
   out.surface = planeZ(plane, cx, cy);
   out.centre = Eigen::Vector3d(cx, cy, out.surface + out.height / n.z());
   if (out.width < config_.min_sherd_size) {
-    why = "narrower than perception.min_sherd_size";
+    // seen from above, a sherd standing on its edge (leaning in a heap) is a strip taller than wide
+    why = out.height > out.width ? "narrower than perception.min_sherd_size seen from above and taller than wide: "
+                                   "standing on its edge? lay it flat"
+                                 : "narrower than perception.min_sherd_size";
     return false;
   }
   if (out.length > config_.max_sherd_size) {

@@ -47,7 +47,8 @@ def grasp(b, o: Observation, station) -> bool:
         held = b.rig.gripper.close().holding
     b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
     if held and not b.rig.gripper.holding():
-        held = False  # slipped out while lifting
+        held = False  # slipped out while lifting: it fell somewhere near (pickup.py looks)
+        b.lift_slips.append((o.grasp_x, o.grasp_y))
     if not held:
         with b.phase("grasping"):
             b.rig.gripper.open(opening_for(o.grasp_width, 0.0))

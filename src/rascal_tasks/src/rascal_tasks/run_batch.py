@@ -279,6 +279,7 @@ class Run:
             )
             if done:  # what the batch before learnt about the mat
                 batch.unpickable = done[-1].unpickable
+                batch.slipped_away = done[-1].slipped_away
                 batch.misses = done[-1].misses
                 batch.pushed = done[-1].pushed
             progress.batch = batch
@@ -323,6 +324,7 @@ class Run:
                     "outcome": outcome,
                     # what the person is told to look at stays with the context's history
                     "not_taken": [describe_leftover(lo) for lo in done[-1].leftovers],
+                    "slipped_away": [list(xy) for xy in done[-1].slipped_away],
                 },
             )
         except psycopg2.Error as e:  # not logged: the next run resumes, which loses nothing
@@ -476,6 +478,11 @@ def what_is_left(batch, rows) -> str:
     rows = rows or []
     counts = (
         (len(batch.unpickable), "left on the pickup mat (could not be picked up)"),
+        (
+            len(batch.slipped_away),
+            "slipped out of the fingers while lifted and not seen again (it may lie beside the "
+            "mat: if every sherd of the bag is recorded, it was found again)",
+        ),
         (sum(r["status"] == "lost" for r in rows), "recorded lost"),
         (
             sum(r["status"] not in ("lost", "picked") and r.get("mass_g") is None for r in rows),
@@ -517,6 +524,8 @@ def print_summary(batches, rows, outcome, wall_seconds):
         print("left in the pickup area (could not be picked up): sherd at (%.3f, %.3f) m" % (x, y))
     for lo in batches[-1].leftovers:
         print(describe_leftover(lo))
+    for x, y in batches[-1].slipped_away:
+        print("slipped out of the fingers while lifted at (%.3f, %.3f) m, not seen again" % (x, y))
     state_times = {}
     for b in batches:
         for k, v in b.state_times.items():
