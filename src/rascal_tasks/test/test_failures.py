@@ -150,8 +150,25 @@ def test_a_sherd_that_slips_out_while_lifted_and_falls_near_is_picked_again(conf
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished"
     assert rec.status() == {1: "done", 2: "done"}
-    assert batch.slipped_away == [] and batch.lift_slips == [(0.25, 0.30)]
+    assert batch.slipped_away == [] and [(o.x, o.y) for o in batch.lift_slips] == [(0.25, 0.30)]
     assert what_is_left(batch, []) == ""
+
+
+def test_a_sherd_that_slips_away_from_a_heap_is_said_though_others_lie_near(config):
+    # in a heap other sherds always lie within the search radius: one of its size must be there
+    world = World(
+        config,
+        [
+            Sherd("a", 0.10, 0.22),
+            Sherd("b", 0.25, 0.30),
+            Sherd("c", 0.28, 0.30, 0.03, 0.025, mass=0.008),
+        ],
+    )
+    world.lift_slips["b"] = None  # falls off the mat; c (smaller) still lies 30 mm away
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert batch.slipped_away == [(0.25, 0.30)]
 
 
 def test_an_arm_timeout_parks_and_stops_with_nothing_else_recorded(config):

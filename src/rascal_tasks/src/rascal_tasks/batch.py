@@ -48,7 +48,8 @@ class Batch:
         self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
         self.misses = {}  # rounded (x, y) -> pickups that failed there
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
-        self.lift_slips: List[tuple] = []  # (x, y) where a grasped sherd slipped out while lifted
+        self.lift_slips: List[Observation] = []  # grasped sherds that slipped out while lifted
+        self.unchecked_slips: List[Observation] = []  # ... not yet looked for by a survey
         # where one slipped so and was not seen near there after: it may lie off the mat
         self.slipped_away: List[tuple] = []
         self.pushed = set()  # rounded (x, y) where a sherd was pushed apart (singulation.py)

@@ -48,7 +48,7 @@ def grasp(b, o: Observation, station) -> bool:
     b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
     if held and not b.rig.gripper.holding():
         held = False  # slipped out while lifting: it fell somewhere near (pickup.py looks)
-        b.lift_slips.append((o.grasp_x, o.grasp_y))
+        b.lift_slips.append(o)
     if not held:
         with b.phase("grasping"):
             b.rig.gripper.open(opening_for(o.grasp_width, 0.0))

@@ -6,7 +6,7 @@ from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction
-from rascal_tasks.survey import survey_at
+from rascal_tasks.survey import same_size
 
 
 class Pickup(BatchState):
@@ -21,8 +21,9 @@ class Pickup(BatchState):
         b = self.batch
         slips = len(b.lift_slips)
         o, tries, held = grasp_retrying(b, b.pending.pop(0), b.pickup)
-        if not held and len(b.lift_slips) > slips:
-            self.look_for_slipped(*b.lift_slips[-1])
+        # a sherd that slipped out while lifted has no number yet: the next survey must see it
+        # again (survey.account_for_slips), unless the retry took it at once
+        b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
         if held:
             if b.renumber is not None:  # two were put back: this one takes over that number
                 b.sherd, b.renumber = b.renumber, None
@@ -45,22 +46,6 @@ class Pickup(BatchState):
                 "%d failed grasps" % (o.x, o.y, 2 * attempts),
             )
         return "missed"
-
-    def look_for_slipped(self, x, y):
-        """A sherd slipped out of the fingers while lifted: it has no number yet, so nothing
-        else would miss it. Nothing seen near where it was held: it may have fallen off the
-        mat, and the batch must not end as if the bag were complete."""
-        b = self.batch
-        radius = b.config["recovery"]["search_radius"]
-        if any(c.distance_to(x, y) < radius for c in survey_at(b, b.pickup, x, y)):
-            return  # it lies near: the next survey offers it again
-        b.slipped_away.append((x, y))
-        b.event(
-            None,
-            "slipped_away",
-            "a sherd slipped out of the fingers while lifted at (%.3f, %.3f) m and is not seen "
-            "within %.0f mm of there: it may lie beside the mat" % (x, y, radius * 1000),
-        )
 
     def singulate(self, o, others, key) -> bool:
         """Failed twice here: push it apart from its neighbours, once per spot (singulation.py),

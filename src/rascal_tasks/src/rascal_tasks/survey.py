@@ -16,6 +16,9 @@ from rascal_tasks.selection import covered, in_pick_order
 CAMERA_OFFSET = urdf_model.camera_offset()
 # Two detections closer than this are the same sherd seen from two survey poses.
 SAME_SHERD = 0.02
+# Two measurements of one sherd agree this well in length and width (one that fell may lie
+# tilted now).
+SAME_SIZE = 0.25
 
 
 def lawnmower(
@@ -70,6 +73,35 @@ def describe_leftover(lo) -> str:
     )
 
 
+def same_size(a, b) -> bool:
+    """Whether observations `a` and `b` may be one sherd by their length and width."""
+    return abs(a.length - b.length) <= SAME_SIZE * b.length and abs(
+        a.width - b.width
+    ) <= SAME_SIZE * max(b.width, 0.5 * b.length)
+
+
+def account_for_slips(b, found: List[Observation]):
+    """Sherds that slipped out of the fingers while lifted (pickup.py) have no number yet, so
+    no row would miss one. Each must be seen again by the survey after it: a sherd of its size
+    within recovery.search_radius of where it was held (others always lie near in a heap).
+    One not seen may lie beside the mat: said, and the batch ends incomplete."""
+    radius = b.config["recovery"]["search_radius"]
+    for o in b.unchecked_slips:
+        x, y = o.grasp_x, o.grasp_y
+        seen = list(found) + list(b.leftovers)
+        if any(c.distance_to(x, y) < radius and same_size(c, o) for c in seen):
+            continue
+        b.slipped_away.append((x, y))
+        b.event(
+            None,
+            "slipped_away",
+            "a %.0f x %.0f mm sherd slipped out of the fingers while lifted at (%.3f, %.3f) m "
+            "and the survey after it sees none of its size within %.0f mm of there: it may lie "
+            "beside the mat" % (o.length * 1000, o.width * 1000, x, y, radius * 1000),
+        )
+    b.unchecked_slips = []
+
+
 def merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
     """Add to `found` the detections of `new` that are not a sherd already in it."""
     for o in new:
@@ -100,6 +132,7 @@ def survey_pickup_area(b) -> List[Observation]:
     b.leftovers = [
         lo for lo in b.leftovers if all(o.distance_to(lo.x, lo.y) > SAME_SHERD for o in found)
     ]
+    account_for_slips(b, found)
     return [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)]
 
 
