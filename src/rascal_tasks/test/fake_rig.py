@@ -35,6 +35,7 @@ class Sherd:
     thickness: float = 0.007  # wall (the height as it lies adds its curvature)
     mass: float = 0.020  # kg
     station: Optional[str] = "pickup"  # None: on the table, off every station
+    support: float = 0.0  # top of the sherd it lies on, above the station (0: on the station)
 
 
 class World:
@@ -63,6 +64,8 @@ class World:
         # sherd name -> the sherd lying under it that its first grasp lifts too (a heap); set
         # down together, the second lands `DOUBLE_APART` from the first
         self.doubles: Dict[str, str] = {}
+        # set down together on the mat, the two stay one on the other (else they fall apart)
+        self.stay_stacked = False
         self.held_extra: Optional[Sherd] = None
 
     def station_at(self, x, y):
@@ -81,6 +84,7 @@ class World:
     def put(self, s: Sherd, x, y):
         st = self.station_at(x, y)
         s.x, s.y, s.station = x, y, st.name if st else None
+        s.support = 0.0
 
     def rig(self) -> rig.Rig:
         return rig.Rig(
@@ -123,6 +127,10 @@ class _Gripper(rig.Gripper):
                 extra, self.w.held_extra = self.w.held_extra, None
                 # on the mat they fall apart (towards its middle); elsewhere they stay together
                 st = self.w.station_at(x, y)
+                if self.w.stay_stacked:  # the first lands on the second
+                    self.w.put(extra, x, y)
+                    s.support = extra.height
+                    return 0.5
                 if st is not None and st.type == "pickup":
                     y += DOUBLE_APART if y <= st.area.center[1] else -DOUBLE_APART
                 self.w.put(extra, x, y)
@@ -131,8 +139,9 @@ class _Gripper(rig.Gripper):
     def close(self):
         x, y, z, _ = self.w.at
         st = self.w.station_at(x, y)
-        for s in self.w.lying(st.name if st else None):
-            if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.height:
+        lying = self.w.lying(st.name if st else None)
+        for s in sorted(lying, key=lambda s: -s.support):  # the top one of a stack
+            if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.support + s.height:
                 self.w.held, self.w.grasped_at = s, (x, y)
                 partner = self.w.doubles.pop(s.name, None)
                 if partner is not None:
@@ -196,13 +205,14 @@ class _Perception(rig.Perception):
                 0.0,
                 s.length,
                 s.width,
-                s.height,
+                s.support + s.height,
                 s.x,
                 s.y,
-                surface + GRASP_ABOVE,
+                surface + s.support + GRASP_ABOVE,
                 0.0,
                 s.width + 0.012,
                 thickness=s.thickness,
+                support=s.support,
             )
             for s in self._in_view(station)
             if self._pickable(s)

@@ -3,6 +3,7 @@ run against the in-memory rig of `fake_rig.py` (no master, no database)."""
 
 import math
 import os
+import re
 
 import pytest
 import yaml
@@ -259,4 +260,24 @@ def test_two_sherds_lifted_as_one_are_put_back_apart_and_recorded_a_row_each(con
     assert masses == [0.015, 0.02, 0.02]  # never 40 g in one row
     assert any("put back apart" in n for r in recorder.sherds.values() for n in r.notes)
     assert recorder.sherds[1].pickup_xy != (0.10, 0.22)  # where its new sherd was picked
+    assert all(s.station == "discard" for s in world.sherds)
+
+
+def test_two_put_back_together_that_stay_one_on_the_other_are_taken_apart(config):
+    # set down together, the two do not fall apart: the top one is picked off and set down at
+    # another free spot, so the next grasp takes one sherd, not the two again
+    world = World(
+        config,
+        [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.29), Sherd("c", 0.20, 0.21, mass=0.015)],
+    )
+    world.doubles = {"a": "b"}
+    world.stay_stacked = True
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished"
+    assert recorder.status() == {1: "done", 2: "done", 3: "done"}
+    masses = sorted(round(r.mass, 4) for r in recorder.sherds.values())
+    assert masses == [0.015, 0.02, 0.02]  # never 40 g in one row
+    notes = {n for r in recorder.sherds.values() for n in r.notes if "put back apart" in n}
+    # two places: the pair's, and the one the top sherd was taken to
+    assert notes and all(len(re.findall(r"\(([-\d.]+), ([-\d.]+)\) m", n)) == 2 for n in notes)
     assert all(s.station == "discard" for s in world.sherds)

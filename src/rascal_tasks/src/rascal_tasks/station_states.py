@@ -10,6 +10,10 @@ from rascal_tasks.rig import Observation
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
 
+# [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
+# another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
+STACKED = 0.002
+
 
 def place_yaw(station, sherd) -> float:
     """The gripper's yaw at a station: the taught one (`rascal teach`), else as picked up (no
@@ -190,6 +194,15 @@ class PutBack(BatchState):
             here = Observation(*spots[0], 0.0, 0.1, 0.1, 0.0, *spots[0], 0.0, 0.0, 0.0)
             spots.append(free_spot(b.pickup.area, b.seen + [here]))
             self._set_down(*spots[1])
+        else:
+            # both came in the one grasp and were set down together: if one still lies on the
+            # other, the top one is taken apart (set down together they may not fall apart,
+            # and the next grasp would take the two again)
+            top = self._lying_on_another(*spots[0])
+            if top is not None and grasp(b, top, b.pickup):
+                here = Observation(*spots[0], 0.0, 0.1, 0.1, 0.0, *spots[0], 0.0, 0.0, 0.0)
+                spots.append(free_spot(b.pickup.area, b.seen + [here]))
+                self._set_down(*spots[1], top)
         text = (
             "two sherds in one grasp: put back apart at %s; this number goes to the next "
             "sherd picked" % ", ".join("(%.3f, %.3f) m" % p for p in spots)
@@ -199,16 +212,32 @@ class PutBack(BatchState):
         b.renumber, b.sherd, b.pending = s, None, []
         return "surveyed"
 
-    def _set_down(self, x, y):
-        """Carry what is in the fingers to (x, y) of the pickup mat and let it go just above."""
+    def _lying_on_another(self, x, y):
+        """The sherd near (x, y) of the pickup mat that lies on another one, or None."""
+        b = self.batch
+        near = [
+            c
+            for c in survey_at(b, b.pickup, x, y)
+            if c.distance_to(x, y) < b.config["recovery"]["search_radius"]
+        ]
+        on_top = [c for c in near if c.support > STACKED]
+        return max(on_top, key=lambda c: c.height) if on_top else None
+
+    def _set_down(self, x, y, held=None):
+        """Carry what is in the fingers to (x, y) of the pickup mat and let it go just above;
+        `held`: the Observation it was grasped as (default: the sherd in progress)."""
         b = self.batch
         s = b.sherd
-        b.move_down(x, y, b.travel_z(), s.grasp_yaw)
-        low = b.pickup.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
-        b.move_down(x, y, low, s.grasp_yaw, linear=True)
+        if held is None:
+            yaw, height, width = s.grasp_yaw, s.grasp_height, s.width
+        else:
+            yaw, height, width = held.grasp_yaw, held.grasp_z - b.pickup.surface_z, held.width
+        b.move_down(x, y, b.travel_z(), yaw)
+        low = b.pickup.surface_z + height + b.config["arm"]["place_clearance"]
+        b.move_down(x, y, low, yaw, linear=True)
         with b.phase("grasping"):
-            b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
-        b.move_down(x, y, b.travel_z(), s.grasp_yaw, linear=True)
+            b.rig.gripper.open(opening_for(width, b.config["arm"]["grasp_margin"]))
+        b.move_down(x, y, b.travel_z(), yaw, linear=True)
 
 
 def free_spot(area, seen, step=0.01, inset=0.035):
