@@ -15,8 +15,8 @@ from rascal_tasks.selection import in_pick_order
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import PUSH, push_direction
 from rascal_tasks.station_states import AtStation
-from rascal_tasks.config import config_from_dict
-from rascal_tasks.survey import NextSherd, lawnmower, merge
+from rascal_tasks.config import Rect, config_from_dict
+from rascal_tasks.survey import NextSherd, lawnmower, merge, on_the_mat
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
@@ -118,6 +118,18 @@ def test_lawnmower_covers_the_area_without_backtracking():
     assert len(grid) == 6
     assert [p[1] for p in grid[:2]] == pytest.approx([-0.05, 0.05])
     assert [p[1] for p in grid[2:4]] == pytest.approx([0.05, -0.05])  # boustrophedon
+
+
+def test_a_leftover_at_the_mats_edge_is_on_the_mat_one_on_the_table_beyond_is_not():
+    mat = Rect((0.16, 0.25), (0.30, 0.16))  # y from 0.17 to 0.33
+
+    def chip(x, y, length=0.05):
+        return rig.Leftover(x, y, length, 0.01, "narrower than perception.min_sherd_size")
+
+    assert on_the_mat(mat, chip(0.13, 0.25))
+    assert on_the_mat(mat, chip(0.13, 0.16))  # its centre 1 cm off, its outline on the mat
+    assert not on_the_mat(mat, chip(0.13, 0.14))  # 3 cm off: beside the mat
+    assert not on_the_mat(mat, chip(-0.03, 0.25, 0.02))  # on the table beyond the mat's end
 
 
 # -- recovery of a dropped sherd, against an in-memory rig ---------------------------------------

@@ -62,6 +62,13 @@ def survey_at(b, station, x, y) -> List[Observation]:
         return b.rig.perception.detect(station.name)
 
 
+def on_the_mat(area, lo) -> bool:
+    """Whether leftover `lo` reaches onto the pickup area (config.Rect): its centre within half
+    its length of it (one at the mat's edge is the bag's; the table beyond is not)."""
+    (cx, cy), (sx, sy) = area.center, area.size
+    return abs(lo.x - cx) <= sx / 2 + lo.length / 2 and abs(lo.y - cy) <= sy / 2 + lo.length / 2
+
+
 def describe_leftover(lo) -> str:
     """One line for a person: what lies on the mat, where, and why it was not taken."""
     return "%.0f x %.0f mm at (%.3f, %.3f) m left on the pickup mat, not taken: %s" % (
@@ -124,7 +131,7 @@ def survey_pickup_area(b) -> List[Observation]:
             [
                 lo
                 for lo in b.rig.perception.leftovers(b.pickup.name)
-                if b.pickup.area.has((lo.x, lo.y))
+                if on_the_mat(b.pickup.area, lo)
                 and all(o.distance_to(lo.x, lo.y) > SAME_SHERD for o in found)
             ],
         )
