@@ -100,6 +100,26 @@ rascal_msgs::Leftover toLeftover(const Leftover& l) {
   return m;
 }
 
+namespace {
+/// An ADD marker with an identity orientation (rviz drops markers with a zero quaternion).
+visualization_msgs::Marker newMarker(const std_msgs::Header& header, const char* ns, size_t id, int type) {
+  visualization_msgs::Marker m;
+  m.header = header;
+  m.ns = ns;
+  m.id = static_cast<int>(id);
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  return m;
+}
+
+std_msgs::ColorRGBA rgba(float r, float g, float b, float a) {
+  std_msgs::ColorRGBA c;
+  c.r = r, c.g = g, c.b = b, c.a = a;
+  return c;
+}
+}  // namespace
+
 visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherds, const std_msgs::Header& header,
                                         const std::vector<Leftover>& leftovers) {
   visualization_msgs::MarkerArray a;
@@ -109,12 +129,7 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
   a.markers.push_back(clear);
   for (size_t i = 0; i < sherds.size(); ++i) {
     const SherdDetection& d = sherds[i];
-    visualization_msgs::Marker box;
-    box.header = header;
-    box.ns = "sherds";
-    box.id = static_cast<int>(i);
-    box.type = visualization_msgs::Marker::CUBE;
-    box.action = visualization_msgs::Marker::ADD;
+    visualization_msgs::Marker box = newMarker(header, "sherds", i, visualization_msgs::Marker::CUBE);
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     // from what it rests on (the table, or the sherd under it in a heap) to its top
     const double h = std::max(d.height - d.support, 0.002);
@@ -145,10 +160,7 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
     arrow.scale.x = 0.004;
     arrow.scale.y = 0.008;
     arrow.scale.z = 0.01;
-    arrow.color.r = 1.0f;
-    arrow.color.g = 0.0f;
-    arrow.color.b = 1.0f;
-    arrow.color.a = 1.0f;
+    arrow.color = rgba(1.0f, 0.0f, 1.0f, 1.0f);
     a.markers.push_back(arrow);
 
     visualization_msgs::Marker fingers = arrow;  // the closing direction, across the minor axis
@@ -178,20 +190,11 @@ visualization_msgs::MarkerArray markers(const std::vector<SherdDetection>& sherd
   }
   for (size_t i = 0; i < leftovers.size(); ++i) {
     const Leftover& l = leftovers[i];
-    visualization_msgs::Marker disc;
-    disc.header = header;
-    disc.ns = "leftovers";
-    disc.id = static_cast<int>(i);
-    disc.type = visualization_msgs::Marker::CYLINDER;
-    disc.action = visualization_msgs::Marker::ADD;
+    visualization_msgs::Marker disc = newMarker(header, "leftovers", i, visualization_msgs::Marker::CYLINDER);
     disc.pose.position = tf2::toMsg(l.position);
-    disc.pose.orientation.w = 1.0;
     disc.scale.x = disc.scale.y = std::max(l.length, 0.005);
     disc.scale.z = 0.002;
-    disc.color.r = 1.0f;
-    disc.color.g = 0.85f;
-    disc.color.b = 0.0f;
-    disc.color.a = 0.8f;
+    disc.color = rgba(1.0f, 0.85f, 0.0f, 0.8f);
     a.markers.push_back(disc);
     visualization_msgs::Marker text = disc;
     text.ns = "leftover_labels";
