@@ -47,7 +47,7 @@ def grasp(b, o: Observation, station) -> bool:
         held = b.rig.gripper.close().holding
     b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
     if held and not b.rig.gripper.holding():
-        held = False  # slipped out while lifting: it fell somewhere near (pickup.py looks)
+        held = False  # slipped out while lifting (survey.account_for_slips looks for it)
         b.lift_slips.append(o)
     if not held:
         with b.phase("grasping"):

@@ -327,10 +327,13 @@ class RosPerception(rig.Perception):
     def calibrate(self, station):
         self._call(self._calibrate, station, "CALIBRATION")
 
-    def detect(self, station):
-        res = self._call(self._detect, station, "DETECT")
+    def _answer(self, station, res):
+        """A successful Detect answer -> its observations; its leftovers kept for `leftovers`."""
         self._leftovers[station] = [leftover_from_msg(m) for m in res.leftovers]
         return [observation_from_msg(s) for s in res.detections.sherds]
+
+    def detect(self, station):
+        return self._answer(station, self._call(self._detect, station, "DETECT"))
 
     def leftovers(self, station):
         return list(self._leftovers.get(station, []))
@@ -341,10 +344,7 @@ class RosPerception(rig.Perception):
         # those (at start-up with the simulator at full speed, TF lags the images) says it on
         # the retry. (Retrying through detect() turned that answer into an error.)
         res = self._call(self._detect, station, "DETECT", none_if="no background model")
-        if res is None:
-            return None
-        self._leftovers[station] = [leftover_from_msg(m) for m in res.leftovers]
-        return [observation_from_msg(s) for s in res.detections.sherds]
+        return None if res is None else self._answer(station, res)
 
 
 class RosScale(rig.Scale):

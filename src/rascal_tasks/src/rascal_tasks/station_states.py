@@ -191,8 +191,7 @@ class PutBack(BatchState):
                 raise SherdFailure(
                     "the second of two sherds lifted as one stays on the %s" % st.name, st
                 )
-            here = Observation(*spots[0], 0.0, 0.1, 0.1, 0.0, *spots[0], 0.0, 0.0, 0.0)
-            spots.append(free_spot(b.pickup.area, b.seen + [here]))
+            spots.append(self._spot_beside(spots[0]))
             self._set_down(*spots[1])
         else:
             # both came in the one grasp and were set down together: if one still lies on the
@@ -200,8 +199,7 @@ class PutBack(BatchState):
             # and the next grasp would take the two again)
             top = self._lying_on_another(*spots[0])
             if top is not None and grasp(b, top, b.pickup):
-                here = Observation(*spots[0], 0.0, 0.1, 0.1, 0.0, *spots[0], 0.0, 0.0, 0.0)
-                spots.append(free_spot(b.pickup.area, b.seen + [here]))
+                spots.append(self._spot_beside(spots[0]))
                 self._set_down(*spots[1], top)
         text = (
             "two sherds in one grasp: put back apart at %s; this number goes to the next "
@@ -211,6 +209,12 @@ class PutBack(BatchState):
         s.note(text)
         b.renumber, b.sherd, b.pending = s, None, []
         return "surveyed"
+
+    def _spot_beside(self, first):
+        """The freest spot of the pickup mat once something lies at `first` too."""
+        b = self.batch
+        here = Observation(*first, 0.0, 0.1, 0.1, 0.0, *first, 0.0, 0.0, 0.0)
+        return free_spot(b.pickup.area, b.seen + [here])
 
     def _lying_on_another(self, x, y):
         """The sherd near (x, y) of the pickup mat that lies on another one, or None."""

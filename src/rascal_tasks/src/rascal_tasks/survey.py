@@ -93,9 +93,9 @@ def account_for_slips(b, found: List[Observation]):
     within recovery.search_radius of where it was held (others always lie near in a heap).
     One not seen may lie beside the mat: said, and the batch ends incomplete."""
     radius = b.config["recovery"]["search_radius"]
+    seen = list(found) + list(b.leftovers)
     for o in b.unchecked_slips:
         x, y = o.grasp_x, o.grasp_y
-        seen = list(found) + list(b.leftovers)
         if any(c.distance_to(x, y) < radius and same_size(c, o) for c in seen):
             continue
         b.slipped_away.append((x, y))
