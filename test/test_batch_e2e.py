@@ -192,6 +192,26 @@ def test_ctrl_c_parks_the_arm_and_a_rerun_finishes_the_batch(rig_factory, db, tm
     _rerun_finishes_once_each(rig, db, "E2E-INT", truth)
 
 
+def test_a_sherd_standing_on_its_edge_is_pushed_over_and_recorded(rig_factory, db, tmp_path):
+    # small_3's first sherd made flat and stood on its long edge (as a tipped-out bag leaves
+    # some), its scanned fragment left out: perception says it stands, the arm pushes it over,
+    # and both are recorded
+    with open(SMALL) as f:
+        scenario = yaml.safe_load(f)
+    standing = scenario["sherds"][0]
+    standing["curvature"] = 0.0
+    standing["tilt"] = round(math.pi / 2, 5)
+    scenario["sherds"] = scenario["sherds"][:2]
+    path = tmp_path / "on_edge.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    rig = rig_factory(scenario=str(path), archive=tmp_path / "archive")
+    code, out = run_batch(rig, db, "E2E-EDGE")
+    assert code == exit_codes.COMPLETE, out[-3000:] + rig.tail()
+    recorded = rows(db, "E2E-EDGE")
+    assert [r["status"] for r in recorded] == ["done", "done"], _summary(recorded)
+    assert "laid_flat" in out and "standing on its edge" in out, out[-3000:]
+
+
 def test_a_chip_too_small_to_pick_is_said_and_the_bag_is_not_complete(rig_factory, db, tmp_path):
     # small_3's first sherd made a 12 x 9 mm chip (under perception.min_sherd_size) and its
     # scanned fragment left out: one sherd to record, one chip the batch must not pass over

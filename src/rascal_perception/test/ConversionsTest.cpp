@@ -92,10 +92,16 @@ TEST(Conversions, LeftoversAreDiscsSayingWhyTheyAreNotTaken) {
   l.position = Eigen::Vector3d(0.15, 0.3, 0.002);
   l.length = 0.012;
   l.width = 0.009;
+  l.yaw = -0.4;
+  l.height = 0.02;
+  l.on_edge = true;
   l.why = "narrower than perception.min_sherd_size";
   const rascal_msgs::Leftover msg = conversions::toLeftover(l);
   EXPECT_DOUBLE_EQ(msg.position.y, 0.3);
   EXPECT_DOUBLE_EQ(msg.width, 0.009);
+  EXPECT_DOUBLE_EQ(msg.yaw, -0.4);
+  EXPECT_DOUBLE_EQ(msg.height, 0.02);
+  EXPECT_TRUE(msg.on_edge);
   EXPECT_EQ(msg.why, l.why);
   const visualization_msgs::MarkerArray m = conversions::markers({}, std_msgs::Header(), {l});
   ASSERT_EQ(m.markers.size(), 3u);  // DELETEALL, disc, label

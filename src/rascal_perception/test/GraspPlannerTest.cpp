@@ -76,3 +76,53 @@ TEST(GraspPlanner, ScoresCrowdedSherdsLower) {
   EXPECT_LT(v[0].score, v[2].score);
   EXPECT_NEAR(v[2].score, 1.0, 1e-9);
 }
+
+namespace {
+/// A camera 0.3 m straight above (0.2, 0.25) on the table z = 0, and its height map with a
+/// 10 mm tall neighbour beside each long side of a sherd lying along x there: strips 44 mm long
+/// (x within 22 mm of the sherd's centre), from 18 to 40 mm off its axis.
+struct CrowdedView {
+  CameraView view;
+  cv::Mat height;
+  CrowdedView() {
+    view.base_T_camera.translation() = Eigen::Vector3d(0.2, 0.25, 0.3);
+    view.base_T_camera.linear() = Eigen::Vector3d(1, -1, -1).asDiagonal();  // optical z down
+    const CameraIntrinsics& k = view.intrinsics;
+    height = cv::Mat(k.height, k.width, CV_32F, cv::Scalar(0.0f));
+    for (int v = 0; v < k.height; ++v) {
+      for (int u = 0; u < k.width; ++u) {
+        const Eigen::Vector3d p = view.base_T_camera * (0.3 * k.ray(u, v));  // on the table
+        const double dx = std::fabs(p.x() - 0.2), dy = std::fabs(p.y() - 0.25);
+        if (dx <= 0.022 && dy >= 0.018 && dy <= 0.040) height.at<float>(v, u) = 0.010f;
+      }
+    }
+  }
+};
+}  // namespace
+
+TEST(GraspPlanner, TurnsARoundSherdClearOfItsNeighboursButNotAnElongatedOne) {
+  const GraspPlanner planner(withGripper());
+  const CrowdedView crowd;
+  GraspContext context;
+  context.height = &crowd.height;
+  context.view = &crowd.view;
+  // near-round (40 x 36 mm): across its minor axis the fingers land on the neighbours; turned
+  // 90 degrees they close on a chord only 11 % longer, clear of them
+  SherdDetection round = sherd(0.2, 0.25, 0.0, 0.040, 0.036, 0.008);
+  planner.plan(round, &context);
+  EXPECT_TRUE(round.grasp_clear);
+  EXPECT_NEAR(std::fabs(round.grasp.linear().col(1).x()), 1.0, 1e-9);  // closing along x: turned 90 degrees
+  EXPECT_NEAR(round.grasp_width, 0.040 + 0.012, 1e-9);
+  // elongated (60 x 30 mm): turned 90 degrees the fingers are clear too, but would close on its
+  // ends (chord 2x its width): not offered as clear, so it waits for its neighbours to go
+  SherdDetection longer = sherd(0.2, 0.25, 0.0, 0.060, 0.030, 0.008);
+  planner.plan(longer, &context);
+  EXPECT_FALSE(longer.grasp_clear);
+  // with the neighbours gone it is taken across its minor axis
+  const cv::Mat empty = cv::Mat::zeros(crowd.height.size(), CV_32F);
+  context.height = &empty;
+  SherdDetection alone = sherd(0.2, 0.25, 0.0, 0.060, 0.030, 0.008);
+  planner.plan(alone, &context);
+  EXPECT_TRUE(alone.grasp_clear);
+  EXPECT_NEAR(std::fabs(alone.grasp.linear().col(1).y()), 1.0, 1e-9);
+}

@@ -230,6 +230,26 @@ TEST(SherdDetector, AChipTooSmallToPickIsSaidWhereItLies) {
   EXPECT_NEAR(l.position.z(), pickupZ(), 0.002);
   EXPECT_LT(l.width, config().min_sherd_size);
   EXPECT_NE(l.why.find("min_sherd_size"), std::string::npos) << l.why;
+  EXPECT_FALSE(l.on_edge) << l.height;  // as thick as it is wide, but no taller than a chip
+}
+
+TEST(SherdDetector, ASherdStandingOnItsEdgeIsSaidToBeSoWithItsHeightAndDirection) {
+  // small_3's first sherd (55 x 40 mm, 7 mm wall) turned onto its long edge: seen from above a
+  // strip about its wall thick, 40 mm tall; the task layer pushes it over across that strip
+  rascal_sim::Scenario sc = loadScenario("small_3.yaml");
+  sc.sherds[0].tilt = M_PI / 2;
+  const Frame f = render(sc, surveyJoints());
+  SherdDetector d(config());
+  const DetectionResult r = calibrateAndDetect(sc, f, d);
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_EQ(r.sherds.size(), 2u);
+  ASSERT_EQ(r.leftovers.size(), 1u);
+  const Leftover& l = r.leftovers[0];
+  EXPECT_TRUE(l.on_edge) << l.why;
+  EXPECT_NE(l.why.find("edge"), std::string::npos) << l.why;
+  EXPECT_LT((l.position.head<2>() - sc.sherds[0].pose.head<2>()).norm(), 0.008) << l.position.transpose();
+  EXPECT_NEAR(l.height, 0.040, 0.008);
+  EXPECT_LT(std::fabs(wrapHalfPi(l.yaw - sc.sherds[0].pose.z())), 0.15) << l.yaw;
 }
 
 TEST(SherdDetector, GeneratedScenesUnderFieldLighting) {

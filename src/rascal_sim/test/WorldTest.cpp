@@ -98,3 +98,19 @@ TEST(World, AHeapSettlesInLayersAndStaysOnTheMat) {
   }
   EXPECT_GE(above, 5);
 }
+
+TEST(World, ASherdStandingOnItsLongEdgeStaysUpUntilPushed) {
+  // a tipped-out bag leaves some sherds on their edges; a flat one, spawned so, stands still
+  // (its wall is the base) until something pushes it
+  SherdSpec s = slab("edge", 0.15, 0.25);
+  s.curvature = 0.0;
+  s.pose.z() = 0.0;
+  s.tilt = M_PI / 2;
+  World world(layout(), gripper());
+  world.spawn({s});
+  for (int i = 0; i < 2000; ++i) world.step(0.001);
+  const SherdState st = world.sherd(0);
+  EXPECT_GT(std::fabs(st.pose.linear()(2, 1)), 0.95) << "its width is no longer upright";
+  EXPECT_NEAR(st.pose.translation().x(), 0.15, 0.003);
+  EXPECT_NEAR(st.pose.translation().y(), 0.25, 0.003);
+}

@@ -17,6 +17,7 @@ from typing import Dict, List, Optional
 from rascal_tasks import rig
 from rascal_tasks.catalogue.errors import StatusError
 from rascal_tasks.sorting import SherdValues, choose_bin
+from rascal_tasks.singulation import FINGERTIP
 from rascal_tasks.survey import CAMERA_OFFSET
 
 VIEW_RADIUS = 0.15  # m around the wrist camera's axis
@@ -36,6 +37,13 @@ class Sherd:
     mass: float = 0.020  # kg
     station: Optional[str] = "pickup"  # None: on the table, off every station
     support: float = 0.0  # top of the sherd it lies on, above the station (0: on the station)
+    # standing on its long edge along x (seen from above: length x thickness, width tall); a
+    # sweep of the fingers through it below its top lays it flat, unless it is `wedged`
+    standing: bool = False
+    wedged: bool = False
+    # the chord its grasp closes on, when perception turns the grasp off its minor axis (to
+    # clear a neighbour): the fingers must open wider than this, or they land on it
+    chord: Optional[float] = None
 
 
 class World:
@@ -67,6 +75,7 @@ class World:
         # set down together on the mat, the two stay one on the other (else they fall apart)
         self.stay_stacked = False
         self.held_extra: Optional[Sherd] = None
+        self.opened = 0.074  # [m] the gripper's last opening
 
     def station_at(self, x, y):
         for st in self.config.stations.values():
@@ -86,6 +95,23 @@ class World:
         s.x, s.y, s.station = x, y, st.name if st else None
         s.support = 0.0
 
+    def sweep(self, a, b, z):
+        """The closed fingers moved level from `a` to `b` at ee height `z`: a standing sherd whose
+        middle they passed within 10 mm of, below its top, falls over that way (half its
+        height on)."""
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        n = math.hypot(dx, dy)
+        if n == 0:
+            return
+        for s in self.lying("pickup"):
+            top = self.config.stations["pickup"].surface_z + s.width
+            t = ((s.x - a[0]) * dx + (s.y - a[1]) * dy) / n
+            off = abs((s.x - a[0]) * dy - (s.y - a[1]) * dx) / n
+            if not s.standing or s.wedged or not 0 < t < n or off > 0.01 or z - FINGERTIP > top:
+                continue
+            s.standing = False
+            self.put(s, s.x + dx / n * s.width / 2, s.y + dy / n * s.width / 2)
+
     def rig(self) -> rig.Rig:
         return rig.Rig(
             _Arm(self), _Gripper(self), _Perception(self), _Scale(self), _Camera(self), _Clock(self)
@@ -100,6 +126,8 @@ class _Arm(rig.Arm):
         code = self.w.refuse(x, y, z, yaw, linear)
         if code:
             raise rig.RigError("arm", code, "goal (%.3f, %.3f, %.3f)" % (x, y, z))
+        if linear and self.w.at[2] == z:
+            self.w.sweep(self.w.at[:2], (x, y), z)
         self.w.at = (x, y, z, yaw)
         self.w.moves.append((x, y, z, yaw, linear))
         self.w.t += 1.0
@@ -119,6 +147,7 @@ class _Gripper(rig.Gripper):
         self.w = world
 
     def open(self, width=None):
+        self.w.opened = width if width else 0.074
         if self.w.held is not None:
             s, self.w.held = self.w.held, None
             x, y = self.w.at[:2]
@@ -141,6 +170,8 @@ class _Gripper(rig.Gripper):
         st = self.w.station_at(x, y)
         lying = self.w.lying(st.name if st else None)
         for s in sorted(lying, key=lambda s: -s.support):  # the top one of a stack
+            if s.chord is not None and self.w.opened < s.chord:
+                continue  # a finger came down on it
             if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.support + s.height:
                 self.w.held, self.w.grasped_at = s, (x, y)
                 partner = self.w.doubles.pop(s.name, None)
@@ -186,12 +217,24 @@ class _Perception(rig.Perception):
         return [s for s in self.w.lying(station) if math.hypot(s.x - cx, s.y - cy) < VIEW_RADIUS]
 
     def _pickable(self, s):
-        return s.width >= self.w.config["perception"]["min_sherd_size"]
+        return not s.standing and s.width >= self.w.config["perception"]["min_sherd_size"]
 
     def leftovers(self, station):
-        """Like the detector: what is narrower than min_sherd_size is said, not offered."""
+        """Like the detector: what is narrower than min_sherd_size is said, not offered; one
+        standing on its edge is as wide as it is thick and as tall as it is wide."""
+        surface = self.w.config.stations[station].surface_z
         return [
-            rig.Leftover(s.x, s.y, s.length, s.width, "narrower than perception.min_sherd_size")
+            rig.Leftover(
+                s.x,
+                s.y,
+                s.length,
+                s.thickness if s.standing else s.width,
+                "narrower than perception.min_sherd_size",
+                surface,
+                0.0,
+                s.width if s.standing else s.height,
+                s.standing,
+            )
             for s in self._in_view(station)
             if not self._pickable(s)
         ]
@@ -210,7 +253,7 @@ class _Perception(rig.Perception):
                 s.y,
                 surface + s.support + GRASP_ABOVE,
                 0.0,
-                s.width + 0.012,
+                (s.chord or s.width) + 0.012,
                 thickness=s.thickness,
                 support=s.support,
             )

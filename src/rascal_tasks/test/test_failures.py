@@ -4,6 +4,8 @@ run against the in-memory rig of `fake_rig.py` (no master, no database)."""
 import math
 import os
 import re
+from dataclasses import replace
+from types import SimpleNamespace
 
 import pytest
 import yaml
@@ -13,8 +15,9 @@ from rascal_tasks import workflow
 from rascal_tasks.catalogue.errors import CatalogueError
 from rascal_tasks.config import config_from_dict
 from rascal_tasks.failures import LOSE_SHERD, STOP, SherdFailure, classify
-from rascal_tasks.rig import RigError
+from rascal_tasks.rig import Leftover, Observation, RigError
 from rascal_tasks.run_batch import what_is_left
+from rascal_tasks.singulation import topple_direction, was_pushed
 from rascal_tasks.stations import DiscardStation
 from rascal_tasks.survey import describe_leftover
 
@@ -132,6 +135,62 @@ def test_a_chip_too_small_to_pick_is_left_and_said_not_finished_silently(config)
     assert "1 object on the pickup mat not taken as sherds" in left
     assert "min_sherd_size" in describe_leftover(batch.leftovers[0])
     assert "12 x 9 mm at (0.250, 0.300) m" in describe_leftover(batch.leftovers[0])
+
+
+def test_a_sherd_grasped_on_a_turned_chord_is_taken_again_blind_as_wide(config):
+    # perception turned its grasp to clear a neighbour: the fingers closed on a 48 mm chord of a
+    # 30 mm wide sherd; at the scale and the camera it is picked again as it was held
+    world = World(config, [Sherd("a", 0.10, 0.22, 0.05, 0.03, chord=0.048)])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done"}
+    assert world.opened >= 0.048  # opened as wide as it was held, at every station
+
+
+def test_a_sherd_standing_on_its_edge_is_pushed_over_and_recorded(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, standing=True)])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert batch.leftovers == [] and what_is_left(batch, []) == ""
+    assert [s.station for s in world.sherds] == ["discard", "discard"]
+    assert len(batch.pushed) == 1
+
+
+def test_a_standing_sherd_that_will_not_fall_is_pushed_once_and_said(config):
+    world = World(
+        config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, standing=True, wedged=True)]
+    )
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done"}
+    assert len(batch.pushed) == 1  # one try at its spot, then it is left for a person
+    assert [(lo.x, lo.y, lo.on_edge) for lo in batch.leftovers] == [(0.25, 0.30, True)]
+    assert "1 object on the pickup mat not taken as sherds" in what_is_left(batch, [])
+
+
+def test_a_pushed_sherd_that_still_fails_is_not_chased_across_the_mat():
+    pushed = Observation(0.10, 0.25, 0, 0.05, 0.03, 0.01, 0.10, 0.25, 0.01, 0, 0.042)
+    b = SimpleNamespace(pushed_to=[((0.14, 0.25), pushed)])
+    moved = replace(pushed, x=0.145, y=0.26)  # where the push sent it, a little turned
+    assert was_pushed(b, moved)
+    assert not was_pushed(b, replace(moved, length=0.03))  # another sherd lies there
+    assert not was_pushed(b, replace(pushed, x=0.20))  # and this one was never pushed
+
+
+def test_a_standing_sherd_falls_towards_the_middle_of_the_mat_and_away_from_others(config):
+    area = config.stations["pickup"].area
+    (cx, cy), sy = area.center, area.size[1]
+    near_edge = Leftover(cx, cy + sy / 2 - 0.02, 0.05, 0.007, "", 0.0, 0.0, 0.04, True)
+    assert topple_direction(near_edge, [], area) == pytest.approx((0.0, -1.0))  # inwards
+    lo = Leftover(cx, cy, 0.05, 0.007, "", 0.0, 0.0, 0.04, True)
+    beside = Leftover(cx, cy - 0.03, 0.03, 0.02, "", 0.0, 0.0, 0.005)
+    assert topple_direction(lo, [lo, beside], area) == pytest.approx((0.0, 1.0))  # away from it
+    turned = Leftover(cx, cy, 0.05, 0.007, "", 0.0, math.pi / 2, 0.04, True)
+    assert abs(topple_direction(turned, [], area)[1]) == pytest.approx(0.0, abs=1e-9)  # across x
+    # as tall as the mat is narrow: it would fall off whichever way
+    tall = Leftover(cx, cy, 0.05, 0.007, "", 0.0, 0.0, 2 * sy, True)
+    assert topple_direction(tall, [], area) is None
 
 
 def test_a_sherd_that_slips_out_while_lifted_and_vanishes_is_said(config):

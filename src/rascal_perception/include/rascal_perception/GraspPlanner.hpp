@@ -11,8 +11,9 @@
 // With the height map (GraspContext) the fingers' footprints are checked too: each finger, 20 mm
 // wide and 8 mm thick, beside the sherd at the opening, must close above what lies there (a
 // neighbour in a heap). The minor axis is tried first, then turned by 15, 30, 45 and 90 degrees
-// (the opening follows the outline's extent across each); the first clear one is taken, else the
-// clearest (grasp_clear false).
+// (the opening follows the outline's extent across each); the first clear one is taken (grasp_clear
+// unless its chord is much longer than the minor axis's, kMaxChordRatio), else the clearest
+// (grasp_clear false).
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -37,6 +38,12 @@ class GraspPlanner {
   static constexpr double kFingerThickness = 0.008;
   /// [m] a fingertip this far above what lies under its footprint (90th percentile) is clear
   static constexpr double kFingerClearance = 0.0005;
+  /// A grasp turned off the minor axis closes on a longer chord, nearer the sherd's narrow ends
+  /// and with its length as a lever about the contacts: one whose chord is longer than this times
+  /// the minor-axis chord is not offered as clear (grasp_clear false: an elongated sherd turned
+  /// 45 or 90 degrees to miss a neighbour slips, so it waits until its neighbours are gone). A
+  /// near-round sherd turns freely.
+  static constexpr double kMaxChordRatio = 1.25;
 
   /// Throws std::invalid_argument when config.gripper has no finger limits (not read from a URDF).
   explicit GraspPlanner(const PerceptionConfig& config);

@@ -2,6 +2,7 @@
 // Value types shared by the perception core: camera intrinsics, the configuration (perception.*
 // of config/rascal.yaml, the gripper from the URDF), segmented blobs and measured sherds. No ROS.
 #include <Eigen/Geometry>
+#include <cmath>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -11,6 +12,14 @@
 namespace rascal_perception {
 
 /// Pinhole intrinsics of the colour stream (the aligned depth shares them).
+/// An axis's direction [rad] in (-pi/2, pi/2]: a and a + pi are one axis (a sherd's long side,
+/// the two alike fingers' closing line).
+inline double wrapHalfPi(double a) {
+  while (a > M_PI / 2) a -= M_PI;
+  while (a <= -M_PI / 2) a += M_PI;
+  return a;
+}
+
 struct CameraIntrinsics {
   int width = 640, height = 480;
   double fx = 615.0, fy = 615.0, cx = 320.0, cy = 240.0;
@@ -85,7 +94,12 @@ struct SherdDetection {
 struct Leftover {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m] centre of its outline, on the surface
   double length = 0.0, width = 0.0;                   ///< [m] its image box on the surface (about)
-  std::string why;                                    ///< one line naming the rule
+  double yaw = 0.0;     ///< [rad] its long side's direction about base_link z, in (-pi/2, pi/2]
+  double height = 0.0;  ///< [m] its top above the surface (0: no depth there)
+  /// taller than wide and at least perception.min_sherd_size tall: a sherd standing on its edge
+  /// (leaning in a heap); pushed over, it lies flat
+  bool on_edge = false;
+  std::string why;  ///< one line naming the rule
 };
 
 /// Result of a detection: the sherds by score, best first (ties in segmentation order), or why

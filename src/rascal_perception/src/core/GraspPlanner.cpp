@@ -47,6 +47,7 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
   if (context && context->height && context->view && !context->height->empty() && s.outline.size() >= 3) {
     double best = -std::numeric_limits<double>::infinity();
     bool found = false;
+    double chord0 = 0.0;  // across the minor axis
     for (const double turn_deg : {0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 90.0}) {
       const double y = s.yaw + turn_deg * M_PI / 180.0;
       const Eigen::Vector2d across(-std::sin(y), std::cos(y));  // the fingers close along R*y
@@ -56,13 +57,16 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
         lo = std::min(lo, t);
         hi = std::max(hi, t);
       }
+      if (turn_deg == 0.0) chord0 = hi - lo;
       const double need = hi - lo + config_.grasp_margin;
       if (need > maxOpening()) continue;
       const double open = std::clamp(need, minOpening(), maxOpening());
       const Eigen::Vector2d c = s.centre.head<2>() + across * (lo + hi) / 2;
       const double clear = fingerClearance(y, open, c, s.surface, tip, *context);
       if (clear >= kFingerClearance) {
-        yaw = y, centre = c, opening = open, best = clear, found = true;
+        // a long chord is still the grasp to try (nothing nearer the minor axis is clear), but
+        // not offered as clear: the task layer takes other sherds first
+        yaw = y, centre = c, opening = open, best = clear, found = hi - lo <= kMaxChordRatio * chord0;
         break;
       }
       if (clear > best) yaw = y, centre = c, opening = open, best = clear;
@@ -70,8 +74,7 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
     s.finger_clearance = std::isfinite(best) ? best : -1.0;
     s.grasp_clear = found;
   }
-  while (yaw > M_PI / 2) yaw -= M_PI;  // the two fingers are alike: yaw and yaw + pi are one grasp
-  while (yaw <= -M_PI / 2) yaw += M_PI;
+  yaw = wrapHalfPi(yaw);  // the two fingers are alike: yaw and yaw + pi are one grasp
   s.grasp = Eigen::Isometry3d::Identity();
   s.grasp.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY())).toRotationMatrix();

@@ -14,6 +14,24 @@ namespace {
 bool samePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.translation() - b.translation()).norm() < 1e-4 && (a.linear() - b.linear()).norm() < 1e-4;
 }
+
+/// [m] the top of `blob` above the table plane: the 90th percentile of its pixels' heights
+/// (a few flying pixels at its edge do not count); 0 without a height map.
+double topHeight(const Blob& blob, const cv::Mat& height) {
+  if (height.empty()) return 0.0;
+  std::vector<float> h;
+  for (int r = 0; r < blob.mask.rows; ++r) {
+    for (int c = 0; c < blob.mask.cols; ++c) {
+      if (!blob.mask.at<uint8_t>(r, c)) continue;
+      const float v = height.at<float>(r + blob.bounds.y, c + blob.bounds.x);
+      if (v == v) h.push_back(v);
+    }
+  }
+  if (h.empty()) return 0.0;
+  const size_t k = h.size() * 9 / 10;
+  std::nth_element(h.begin(), h.begin() + k, h.end());
+  return std::max(0.0f, h[k]);
+}
 }  // namespace
 
 SherdDetector::SherdDetector(const PerceptionConfig& config)
@@ -273,9 +291,20 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
     l.why = why;
     l.length = std::max(b.box.size.width, b.box.size.height) / ppm;
     l.width = std::min(b.box.size.width, b.box.size.height) / ppm;
-    if (SherdMeasurer::intersect(view, r.plane, 0.0, b.box.center.x, b.box.center.y, l.position)) {
-      r.leftovers.push_back(std::move(l));
+    if (!SherdMeasurer::intersect(view, r.plane, 0.0, b.box.center.x, b.box.center.y, l.position)) return;
+    // its long side's direction on the surface: the box's long side, its end taken to the plane
+    cv::Point2f q[4];
+    b.box.points(q);
+    const cv::Point2f side = cv::norm(q[1] - q[0]) >= cv::norm(q[2] - q[1]) ? q[1] - q[0] : q[2] - q[1];
+    Eigen::Vector3d end;
+    if (SherdMeasurer::intersect(view, r.plane, 0.0, b.box.center.x + side.x / 2, b.box.center.y + side.y / 2, end)) {
+      l.yaw = wrapHalfPi(std::atan2(end.y() - l.position.y(), end.x() - l.position.x()));
     }
+    l.height = topHeight(b, height);
+    // a sherd on its edge is as tall as a pickable sherd is wide; a thick chip is not
+    l.on_edge = l.height > l.width && l.height >= config_.min_sherd_size;
+    if (l.on_edge && l.why.find("edge") == std::string::npos) l.why += "; taller than wide: standing on its edge?";
+    r.leftovers.push_back(std::move(l));
   };
   for (const Blob& b : blobs) {
     const std::vector<StackPart> parts = stacks_.split(b, height, stack);

@@ -17,12 +17,6 @@ constexpr float kInteriorMargin = 3.0f;
 /// shell fit too (side walls, below).
 constexpr float kWallMarginMm = 1.5f;
 
-double wrapHalfPi(double a) {
-  while (a > M_PI / 2) a -= M_PI;
-  while (a <= -M_PI / 2) a += M_PI;
-  return a;
-}
-
 double planeZ(const Eigen::Vector4d& plane, double x, double y) {
   return -(plane.x() * x + plane.y() * y + plane.w()) / plane.z();
 }

@@ -96,6 +96,9 @@ rascal_msgs::Leftover toLeftover(const Leftover& l) {
   m.position = tf2::toMsg(l.position);
   m.length = l.length;
   m.width = l.width;
+  m.yaw = l.yaw;
+  m.height = l.height;
+  m.on_edge = l.on_edge;
   m.why = l.why;
   return m;
 }

@@ -23,6 +23,9 @@ struct SherdSpec {
   std::string mesh_file;                 ///< optional STL (metres); replaces the outline shell
   Eigen::Vector3d pose{0.0, 0.0, 0.0};   ///< [m, m, rad] x, y, yaw on the table
   double drop_height = 0.0;              ///< [m] gap under the sherd when spawned
+  /// [rad] turned about its own long axis when spawned (pi/2: standing on its long edge, as a
+  /// tipped-out bag leaves some leaning on others; alone it falls once the world steps)
+  double tilt = 0.0;
 };
 
 /// What makes a wrist frame look like a field photo (all 0 = the plain rendering). Wrist camera

@@ -195,6 +195,7 @@ Scenario ScenarioLoader::parse(const std::string& yaml_text) const {
       sp.convex_up = n["convex_up"] ? n["convex_up"].as<bool>() : true;
       sp.density = number(n["density"], k + ".density", 1850, 1000, 3000);
       sp.drop_height = number(n["drop_height"], k + ".drop_height", 0.0, 0.0, 0.5);
+      sp.tilt = number(n["tilt"], k + ".tilt", 0.0, -M_PI, M_PI);
       if (n["munsell"]) {
         sp.munsell = n["munsell"].as<std::string>();
         if (!munsell_.has(sp.munsell)) fail(k + ".munsell", "unknown chip '" + sp.munsell + "'");

@@ -384,9 +384,14 @@ void World::spawn(const std::vector<SherdSpec>& sherds) {
         support = std::max(support, b.centre.z() + b.size.z() / 2);
       }
     }
-    dBodySetPosition(s->body, x, y, support + size.z() / 2 + s->spec.drop_height + 1e-4);
+    const double tilt = s->spec.tilt;
+    const double tall = std::abs(size.y() * std::sin(tilt)) + std::abs(size.z() * std::cos(tilt));
+    dBodySetPosition(s->body, x, y, support + tall / 2 + s->spec.drop_height + 1e-4);
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(s->spec.pose.z(), Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
     dMatrix3 r;
-    dRFromAxisAndAngle(r, 0, 0, 1, s->spec.pose.z());
+    toOde(R, r);
     dBodySetRotation(s->body, r);
     dBodySetLinearDamping(s->body, 0.001);
     dBodySetAngularDamping(s->body, 0.01);

@@ -53,6 +53,7 @@ class Batch:
         # where one slipped so and was not seen near there after: it may lie off the mat
         self.slipped_away: List[tuple] = []
         self.pushed = set()  # rounded (x, y) where a sherd was pushed apart (singulation.py)
+        self.pushed_to: List[tuple] = []  # ((x, y) where it should lie now, its Observation)
         self.pending: List[Observation] = []
         self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
         self.put_back_doubles = {}  # seq -> times its grasp was put back as two sherds in one

@@ -5,8 +5,8 @@ gripper, numbered. No ROS in here.
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction
-from rascal_tasks.survey import same_size
+from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
+from rascal_tasks.selection import same_size
 
 
 class Pickup(BatchState):
@@ -48,15 +48,17 @@ class Pickup(BatchState):
         return "missed"
 
     def singulate(self, o, others, key) -> bool:
-        """Failed twice here: push it apart from its neighbours, once per spot (singulation.py),
-        if the batch has pushes left and a push keeps it on the mat. True when it was pushed."""
+        """Failed twice here: push it apart from its neighbours, once per spot and once per sherd
+        (singulation.py), if the batch has pushes left and a push keeps it on the mat. True when
+        it was pushed."""
         b = self.batch
-        if key in b.pushed or len(b.pushed) >= MAX_PUSHES:
+        if key in b.pushed or len(b.pushed) >= MAX_PUSHES or was_pushed(b, o):
             return False
         b.pushed.add(key)
         d = push_direction(o, others, b.pickup.area)
         if d is None or not push(b, o, d):
             return False
+        b.pushed_to.append(((o.x + PUSH * d[0], o.y + PUSH * d[1]), o))
         b.event(
             None,
             "pushed",

@@ -63,6 +63,10 @@ class Leftover:
     length: float  # [m] about: from the image
     width: float
     why: str  # one line naming the rule
+    surface_z: float = 0.0  # [m] of the surface it lies on
+    yaw: float = 0.0  # [rad] its long side's direction
+    height: float = 0.0  # [m] its top above the surface (0: not seen)
+    on_edge: bool = False  # taller than wide: standing on its edge (singulation.topple)
 
     def distance_to(self, x: float, y: float) -> float:
         return math.hypot(self.x - x, self.y - y)

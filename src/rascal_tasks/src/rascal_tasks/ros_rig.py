@@ -80,7 +80,17 @@ def observation_from_msg(s) -> rig.Observation:
 
 def leftover_from_msg(m) -> rig.Leftover:
     """rascal_msgs/Leftover -> Leftover (both in base_link)."""
-    return rig.Leftover(m.position.x, m.position.y, m.length, m.width, m.why)
+    return rig.Leftover(
+        m.position.x,
+        m.position.y,
+        m.length,
+        m.width,
+        m.why,
+        m.position.z,
+        m.yaw,
+        m.height,
+        m.on_edge,
+    )
 
 
 def _proxy(name, srv_type):

@@ -282,6 +282,7 @@ class Run:
                 batch.slipped_away = done[-1].slipped_away
                 batch.misses = done[-1].misses
                 batch.pushed = done[-1].pushed
+                batch.pushed_to = done[-1].pushed_to
             progress.batch = batch
             self.batch, self.machine = batch, build_machine(batch)
             if self.stop.is_set():  # Ctrl-C while the machine was being built

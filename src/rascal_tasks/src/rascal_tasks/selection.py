@@ -1,5 +1,5 @@
 """Which sherd is picked next: the one selection policy, over the merged survey of the pickup
-area (`perception.selection_policy`). No ROS in here.
+area (`perception.selection_policy`); and whether two looks may be one sherd. No ROS in here.
 """
 
 import math
@@ -11,6 +11,16 @@ from rascal_tasks.rig import Observation
 # a free one is left: lifting it would drag or lift the one on top (a tipped-out bag). Its
 # measurement is of the part that shows; it is picked from a later survey, once uncovered.
 COVERED = 0.05
+# Two measurements of one sherd agree this well in length and width (one that fell may lie
+# tilted now).
+SAME_SIZE = 0.25
+
+
+def same_size(a, b) -> bool:
+    """Whether observations `a` and `b` may be one sherd by their length and width."""
+    return abs(a.length - b.length) <= SAME_SIZE * b.length and abs(
+        a.width - b.width
+    ) <= SAME_SIZE * max(b.width, 0.5 * b.length)
 
 
 def covered(o: Observation) -> bool:

@@ -1,23 +1,38 @@
 """Singulation: a sherd the gripper failed on twice at the same spot of a heap is pushed once,
 away from its neighbours and never off the mat, and the area surveyed again; only a sherd that
-still cannot be picked after that is left for a person. No ROS here.
+still cannot be picked after that is left for a person. A sherd the tipped-out bag left standing
+on its edge (perception's leftover `on_edge`) is pushed over once, so that it lies flat. No ROS
+here.
 
 A push: fingers closed, the gripper turned so both fingers meet the sherd, down beside it at
 the height its grasp closes at (its own mid-height above what it rests on: a sherd lying on
 another is pushed off it), then along the line through its centre.
+A topple: fingers closed and in line with the push (the leading finger's 20 mm face meets the
+middle of the sherd's face, however short it is), down behind it at three quarters of its
+height (above its centre of mass: it tips rather than slides), then across until the finger
+has passed where it stood by half its height.
 """
 
 import math
 from typing import List, Optional, Tuple
 
+from rascal_workcell import urdf_model
+
 from rascal_tasks.failures import about_this_sherd
-from rascal_tasks.rig import Observation, RigError
+from rascal_tasks.rig import Leftover, Observation, RigError
+from rascal_tasks.selection import same_size
 
 PUSH = 0.04  # [m] how far the sherd's centre is pushed: most of a neighbour's width
 LEAD = 0.015  # [m] the fingers start this far outside its outline
 EDGE = 0.01  # [m] a pushed sherd keeps its outline this far inside the mat
 DIRECTIONS = 16
-MAX_PUSHES = 20  # per batch: a heap that needs more is a person's job
+MAX_PUSHES = 20  # per batch (pushes and topples): a heap that needs more is a person's job
+PUSHED_NEAR = 0.025  # [m] a pushed sherd lies about this near where the push sent it
+TOPPLE_AT = 0.75  # of a standing sherd's height: where the finger pushes it
+FINGERTIP = urdf_model.fingertip_offset()  # [m] fingertips below ee_gripper_link
+# [m] ee_gripper_link to the leading finger's outer face, fingers closed and in line with a push
+# (half the closed opening, then the finger's 8 mm: the URDF's finger box)
+FINGER_REACH = urdf_model.opening_limits()[0] / 2 + 0.008
 
 
 def push_direction(
@@ -48,11 +63,57 @@ def push_direction(
 def push(b, o: Observation, d: Tuple[float, float]) -> bool:
     """Push `o` along `d` (see the module). False when the arm refuses a move of it (the
     sherd is then left for a person); other rig errors stop the batch as anywhere."""
-    yaw = math.atan2(d[1], d[0])  # the fingers close across the push: both touch the sherd
     back = o.length / 2 + LEAD
     start = (o.x - back * d[0], o.y - back * d[1])
     end = (o.x + PUSH * d[0], o.y + PUSH * d[1])
-    z = o.grasp_z
+    # the fingers close across the push: both touch the sherd
+    return _sweep(b, (o.x, o.y), start, end, o.grasp_z, math.atan2(d[1], d[0]))
+
+
+def was_pushed(b, o: Observation) -> bool:
+    """Whether `o` is a sherd pushed before (one of its size lying about where a push sent it):
+    pushed once and still not picked, it is a person's job (another push would chase it
+    across the mat, six grasps at every spot)."""
+    return any(
+        math.hypot(o.x - x, o.y - y) < PUSHED_NEAR and same_size(o, p) for (x, y), p in b.pushed_to
+    )
+
+
+def topple_direction(lo: Leftover, others: List[Leftover], area) -> Optional[Tuple[float, float]]:
+    """Which way to push a sherd standing on its edge over: of the two directions across its
+    long side, the one it falls farthest from `others`, lying flat (its length along, its
+    height across) still `EDGE` inside `area` (a config.Rect); None if neither keeps it there."""
+    best, best_room = None, -math.inf
+    half = max(lo.length, lo.height) / 2 + EDGE
+    for sign in (1.0, -1.0):
+        d = (-sign * math.sin(lo.yaw), sign * math.cos(lo.yaw))
+        end = (lo.x + d[0] * lo.height / 2, lo.y + d[1] * lo.height / 2)
+        if any(abs(end[i] - area.center[i]) > area.size[i] / 2 - half for i in (0, 1)):
+            continue
+        room = min(
+            (math.hypot(end[0] - p.x, end[1] - p.y) - p.length / 2 for p in others if p is not lo),
+            default=1.0,
+        )
+        if room > best_room + 1e-9:
+            best, best_room = d, room
+    return best
+
+
+def topple(b, lo: Leftover, d: Tuple[float, float]) -> bool:
+    """Push the standing sherd `lo` over along `d` (see the module). False when the arm
+    refuses a move of it; other rig errors stop the batch as anywhere."""
+    back = lo.width / 2 + LEAD + FINGER_REACH
+    past = lo.width / 2 + lo.height / 2 - FINGER_REACH
+    start = (lo.x - back * d[0], lo.y - back * d[1])
+    end = (lo.x + past * d[0], lo.y + past * d[1])
+    z = lo.surface_z + TOPPLE_AT * lo.height + FINGERTIP
+    # fingers in line with the push: yaw a quarter turn from the direction
+    return _sweep(b, (lo.x, lo.y), start, end, z, math.atan2(d[1], d[0]) + math.pi / 2)
+
+
+def _sweep(b, at_xy, start, end, z, yaw) -> bool:
+    """Fingers closed, down at `start` to ee height `z`, along to `end`, and up again."""
+    yaw = math.remainder(yaw, math.pi)  # the fingers are alike: the turn the wrist has room for
     with b.phase("grasping"):
         b.rig.gripper.close()
     at = None  # where the fingers went down (lifted from there, whatever happens)
@@ -65,9 +126,31 @@ def push(b, o: Observation, d: Tuple[float, float]) -> bool:
     except RigError as e:
         if not about_this_sherd(e, sherd_target=True):
             raise
-        b.event(None, "push_refused", "sherd at (%.3f, %.3f) m: %s" % (o.x, o.y, e))
+        b.event(None, "push_refused", "sherd at (%.3f, %.3f) m: %s" % (*at_xy, e))
         return False
     finally:
         if at is not None:
             b.move_down(*at, b.travel_z(), yaw, linear=True)
     return True
+
+
+def lay_flat(b) -> bool:
+    """Push over every sherd of the last survey's leftovers that stands on its edge, once per
+    spot (counted with the pushes); True when one was pushed (the area is to be surveyed again)."""
+    pushed = False
+    for lo in b.leftovers:
+        key = (round(lo.x, 2), round(lo.y, 2))
+        if not lo.on_edge or key in b.pushed or len(b.pushed) >= MAX_PUSHES:
+            continue
+        b.pushed.add(key)
+        d = topple_direction(lo, b.leftovers, b.pickup.area)
+        if d is None or not topple(b, lo, d):
+            continue
+        pushed = True
+        b.event(
+            None,
+            "laid_flat",
+            "sherd standing on its edge at (%.3f, %.3f) m (%.0f mm tall) pushed over towards "
+            "(%.2f, %.2f)" % (lo.x, lo.y, lo.height * 1000, d[0], d[1]),
+        )
+    return pushed

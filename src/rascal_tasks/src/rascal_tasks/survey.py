@@ -9,16 +9,14 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.rig import Observation
-from rascal_tasks.selection import covered, in_pick_order
+from rascal_tasks.selection import covered, in_pick_order, same_size
+from rascal_tasks.singulation import lay_flat
 
 # Wrist camera offset from ee_gripper_link when the gripper points down, along the gripper's
 # yaw direction (camera_link sits 0.055 m "above" gripper_link in the URDF).
 CAMERA_OFFSET = urdf_model.camera_offset()
 # Two detections closer than this are the same sherd seen from two survey poses.
 SAME_SHERD = 0.02
-# Two measurements of one sherd agree this well in length and width (one that fell may lie
-# tilted now).
-SAME_SIZE = 0.25
 
 
 def lawnmower(
@@ -78,13 +76,6 @@ def describe_leftover(lo) -> str:
         lo.y,
         lo.why,
     )
-
-
-def same_size(a, b) -> bool:
-    """Whether observations `a` and `b` may be one sherd by their length and width."""
-    return abs(a.length - b.length) <= SAME_SIZE * b.length and abs(
-        a.width - b.width
-    ) <= SAME_SIZE * max(b.width, 0.5 * b.length)
 
 
 def account_for_slips(b, found: List[Observation]):
@@ -154,6 +145,8 @@ class Survey(BatchState):
         found = survey_pickup_area(b)
         b.seen = list(found)
         if not found:
+            if lay_flat(b):  # a sherd standing on its edge, pushed over: it may be picked now
+                return self.run()
             b.empty_surveys += 1
             if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
                 if b.renumber is not None:  # its number must not stay unfinished

@@ -109,3 +109,16 @@ def camera_offset(urdf_xml: Optional[str] = None) -> float:
     """How far the wrist camera sits from the gripper's axis, metres: with the gripper pointing
     down it is that far out along the gripper's yaw direction (camera_mount's z)."""
     return _origin("camera_mount", urdf_xml)[2]
+
+
+def fingertip_offset(urdf_xml: Optional[str] = None) -> float:
+    """How far the fingertips reach below ee_gripper_link with the gripper pointing down, metres:
+    the far end of left_finger_link's collision box along the approach axis, from the ee_gripper
+    joint (as rascal_workcell::GripperGeometry reads it; 4.4 mm on the wx250s)."""
+    link = _robot(urdf_xml).find("link[@name='left_finger_link']/collision")
+    box = link.find("geometry/box") if link is not None else None
+    if box is None:
+        raise ValueError("URDF: left_finger_link needs a box collision")
+    origin = link.find("origin")
+    x = float(origin.get("xyz").split()[0]) if origin is not None else 0.0
+    return x + float(box.get("size").split()[0]) / 2 - _origin("ee_gripper", urdf_xml)[0]
