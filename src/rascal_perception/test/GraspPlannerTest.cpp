@@ -113,16 +113,38 @@ TEST(GraspPlanner, TurnsARoundSherdClearOfItsNeighboursButNotAnElongatedOne) {
   EXPECT_TRUE(round.grasp_clear);
   EXPECT_NEAR(std::fabs(round.grasp.linear().col(1).x()), 1.0, 1e-9);  // closing along x: turned 90 degrees
   EXPECT_NEAR(round.grasp_width, 0.040 + 0.012, 1e-9);
-  // elongated (60 x 30 mm): turned 90 degrees the fingers are clear too, but would close on its
-  // ends (chord 2x its width): not offered as clear, so it waits for its neighbours to go
-  SherdDetection longer = sherd(0.2, 0.25, 0.0, 0.060, 0.030, 0.008);
+  // elongated (62 x 35 mm): turned 90 degrees the fingers are clear too, but would close on its
+  // ends (chord 1.8x its width): not offered as clear, so it waits for its neighbours to go
+  SherdDetection longer = sherd(0.2, 0.25, 0.0, 0.062, 0.035, 0.008);
   planner.plan(longer, &context);
   EXPECT_FALSE(longer.grasp_clear);
   // with the neighbours gone it is taken across its minor axis
   const cv::Mat empty = cv::Mat::zeros(crowd.height.size(), CV_32F);
   context.height = &empty;
-  SherdDetection alone = sherd(0.2, 0.25, 0.0, 0.060, 0.030, 0.008);
+  SherdDetection alone = sherd(0.2, 0.25, 0.0, 0.062, 0.035, 0.008);
   planner.plan(alone, &context);
   EXPECT_TRUE(alone.grasp_clear);
   EXPECT_NEAR(std::fabs(alone.grasp.linear().col(1).y()), 1.0, 1e-9);
+}
+
+TEST(GraspPlanner, TurnsASherdTooNarrowToHoldAcrossItsMinorAxis) {
+  // 31 mm across: the fingers would stop 1 mm short of shut (30 mm), which the gripper reads as
+  // empty; turned 15 degrees they close on a 42 mm chord of the 47 x 31 mm outline
+  const GraspPlanner planner(withGripper());
+  EXPECT_NEAR(planner.holdableChord(), 0.034, 1e-12);  // 30 mm shut + 2 x the 2 mm held margin
+  const CrowdedView crowd;
+  const cv::Mat empty = cv::Mat::zeros(crowd.height.size(), CV_32F);
+  GraspContext context;
+  context.height = &empty;
+  context.view = &crowd.view;
+  SherdDetection narrow = sherd(0.2, 0.25, 0.0, 0.047, 0.031, 0.012);
+  planner.plan(narrow, &context);
+  EXPECT_TRUE(narrow.grasp_clear);
+  const double turn = std::atan2(-narrow.grasp.linear().col(1).x(), narrow.grasp.linear().col(1).y());
+  EXPECT_NEAR(std::fabs(turn), 15.0 * M_PI / 180.0, 1e-9);
+  EXPECT_GE(narrow.grasp_width - 0.012, planner.holdableChord());
+  // 36 mm across is held as it is
+  SherdDetection wider = sherd(0.2, 0.25, 0.0, 0.047, 0.036, 0.012);
+  planner.plan(wider, &context);
+  EXPECT_NEAR(wider.grasp_width, 0.036 + 0.012, 1e-9);
 }

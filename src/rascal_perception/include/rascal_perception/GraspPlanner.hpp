@@ -11,9 +11,10 @@
 // With the height map (GraspContext) the fingers' footprints are checked too: each finger, 20 mm
 // wide and 8 mm thick, beside the sherd at the opening, must close above what lies there (a
 // neighbour in a heap). The minor axis is tried first, then turned by 15, 30, 45 and 90 degrees
-// (the opening follows the outline's extent across each); the first clear one is taken (grasp_clear
-// unless its chord is much longer than the minor axis's, kMaxChordRatio), else the clearest
-// (grasp_clear false).
+// (the opening follows the outline's extent across each); the first clear one whose chord the
+// fingers can hold (holdableChord) is taken (grasp_clear unless its chord is much longer than the
+// minor axis's, kMaxChordRatio, while the minor axis itself could be held), else the clearest
+// holdable one, else the clearest (grasp_clear false).
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -53,6 +54,11 @@ class GraspPlanner {
   void score(std::vector<SherdDetection>& sherds) const;
   double minOpening() const { return config_.gripper.minOpening(); }  ///< [m]
   double maxOpening() const { return config_.gripper.maxOpening(); }  ///< [m]
+  /// [m] the least chord across the fingers that they can be told to hold: closed on anything
+  /// narrower they stop within held_margin of shut, which the gripper reads as empty (the
+  /// wx250s's fingers close to 30 mm apart). Twice the margin, so a sherd that is pressed a
+  /// little or narrower at the fingertips' height still reads as held.
+  double holdableChord() const { return minOpening() + 2.0 * config_.held_margin; }
 
  private:
   /// [m] fingertip height above the plane minus what lies under the fingers' footprints.

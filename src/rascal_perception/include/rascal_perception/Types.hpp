@@ -30,7 +30,7 @@ struct CameraIntrinsics {
   }
 };
 
-/// perception.* of config/rascal.yaml (+ arm.grasp_margin; DetectorParameters::read fills it
+/// perception.* of config/rascal.yaml (+ arm.grasp_margin, arm.gripper.held_margin; DetectorParameters::read fills it
 /// through the parameter schema) and the gripper from the URDF. Lengths in metres.
 struct PerceptionConfig {
   int background_clusters = 3;
@@ -43,6 +43,9 @@ struct PerceptionConfig {
   int border_margin = 3;               ///< [px] blobs this close to the border are cut off
   double depth_min = 0.15, depth_max = 1.0;  ///< [m] depth outside is ignored
   double grasp_margin = 0.012;         ///< [m] arm.grasp_margin: opening beyond the measured width
+  /// [m] arm.gripper.held_margin: the gripper says it holds only a sherd that stops the fingers
+  /// this much wider than they close
+  double held_margin = 0.002;
   double grasp_height_fraction = 0.6;  ///< fingertips close at this fraction of the measured height
   double grasp_tip_clearance = 0.0025; ///< [m] fingertips never lower than this above the surface (facts: the paper's clearance)
   /// Finger limits (the opening clamp) and fingertip offset below ee_gripper_link, from the URDF

@@ -21,6 +21,7 @@ DetectorParameters DetectorParameters::read(const rascal_workcell::Parameters& p
   c.grasp_height_fraction = p.number("perception.grasp_height_fraction");
   c.grasp_tip_clearance = p.number("perception.grasp_tip_clearance");
   c.grasp_margin = p.number("arm.grasp_margin");
+  c.held_margin = p.number("arm.gripper.held_margin");
   c.gripper = gripper;
   d.frame_wait = p.number("perception.frame_wait");
   d.refresh_period = p.number("perception.refresh_period");

@@ -45,8 +45,11 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
   Eigen::Vector2d centre = s.centre.head<2>();
   double opening = std::clamp(s.width + config_.grasp_margin, minOpening(), maxOpening());
   if (context && context->height && context->view && !context->height->empty() && s.outline.size() >= 3) {
-    double best = -std::numeric_limits<double>::infinity();
-    bool found = false;
+    struct Candidate {
+      double yaw, opening, clear, chord;
+      Eigen::Vector2d centre;
+    };
+    std::vector<Candidate> candidates;
     double chord0 = 0.0;  // across the minor axis
     for (const double turn_deg : {0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 90.0}) {
       const double y = s.yaw + turn_deg * M_PI / 180.0;
@@ -62,17 +65,28 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
       if (need > maxOpening()) continue;
       const double open = std::clamp(need, minOpening(), maxOpening());
       const Eigen::Vector2d c = s.centre.head<2>() + across * (lo + hi) / 2;
-      const double clear = fingerClearance(y, open, c, s.surface, tip, *context);
-      if (clear >= kFingerClearance) {
-        // a long chord is still the grasp to try (nothing nearer the minor axis is clear), but
-        // not offered as clear: the task layer takes other sherds first
-        yaw = y, centre = c, opening = open, best = clear, found = hi - lo <= kMaxChordRatio * chord0;
+      candidates.push_back({y, open, fingerClearance(y, open, c, s.surface, tip, *context), hi - lo, c});
+    }
+    // the first clear one the fingers can hold; else the clearest they can hold; else the clearest
+    const Candidate* pick = nullptr;
+    for (const Candidate& c : candidates) {
+      if (c.clear >= kFingerClearance && c.chord >= holdableChord()) {
+        pick = &c;
         break;
       }
-      if (clear > best) yaw = y, centre = c, opening = open, best = clear;
     }
-    s.finger_clearance = std::isfinite(best) ? best : -1.0;
-    s.grasp_clear = found;
+    const bool clear = pick != nullptr;
+    for (int holdable = 1; holdable >= 0 && !pick; --holdable) {
+      for (const Candidate& c : candidates) {
+        if ((!holdable || c.chord >= holdableChord()) && (!pick || c.clear > pick->clear)) pick = &c;
+      }
+    }
+    if (pick) yaw = pick->yaw, centre = pick->centre, opening = pick->opening;
+    s.finger_clearance = pick ? pick->clear : -1.0;
+    // a long chord is still the grasp to try (nothing nearer the minor axis is clear), but not
+    // offered as clear: the task layer takes other sherds first. A sherd too narrow to hold
+    // across its minor axis has to be turned.
+    s.grasp_clear = clear && (pick->chord <= kMaxChordRatio * chord0 || chord0 < holdableChord());
   }
   yaw = wrapHalfPi(yaw);  // the two fingers are alike: yaw and yaw + pi are one grasp
   s.grasp = Eigen::Isometry3d::Identity();
