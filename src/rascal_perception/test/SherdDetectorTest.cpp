@@ -214,18 +214,25 @@ TEST(SherdDetector, FindsTheSmallScenarioSherdsIncludingTheMesh) {
   EXPECT_EQ(t.found, t.expected);
 }
 
+namespace {
+/// small_3 with its first sherd changed: the other two are offered, the first is `l`, not offered.
+void theOneLeftover(const rascal_sim::Scenario& sc, Leftover& l) {
+  SherdDetector d(config());
+  const DetectionResult r = calibrateAndDetect(sc, render(sc, surveyJoints()), d);
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_EQ(r.sherds.size(), 2u);
+  ASSERT_EQ(r.leftovers.size(), 1u);
+  l = r.leftovers[0];
+}
+}  // namespace
+
 TEST(SherdDetector, AChipTooSmallToPickIsSaidWhereItLies) {
   // a chip a fifth of small_3's first sherd (11 x 8 mm, under perception.min_sherd_size): not
   // offered, but said, so a batch does not end as if the mat were empty
   rascal_sim::Scenario sc = loadScenario("small_3.yaml");
   for (Eigen::Vector2d& p : sc.sherds[0].outline) p *= 0.2;
-  const Frame f = render(sc, surveyJoints());
-  SherdDetector d(config());
-  const DetectionResult r = calibrateAndDetect(sc, f, d);
-  ASSERT_TRUE(r.success) << r.message;
-  EXPECT_EQ(r.sherds.size(), 2u);
-  ASSERT_EQ(r.leftovers.size(), 1u);
-  const Leftover& l = r.leftovers[0];
+  Leftover l;
+  ASSERT_NO_FATAL_FAILURE(theOneLeftover(sc, l));
   EXPECT_LT((l.position.head<2>() - sc.sherds[0].pose.head<2>()).norm(), 0.004) << l.position.transpose();
   EXPECT_NEAR(l.position.z(), pickupZ(), 0.002);
   EXPECT_LT(l.width, config().min_sherd_size);
@@ -238,13 +245,8 @@ TEST(SherdDetector, ASherdStandingOnItsEdgeIsSaidToBeSoWithItsHeightAndDirection
   // strip about its wall thick, 40 mm tall; the task layer pushes it over across that strip
   rascal_sim::Scenario sc = loadScenario("small_3.yaml");
   sc.sherds[0].tilt = M_PI / 2;
-  const Frame f = render(sc, surveyJoints());
-  SherdDetector d(config());
-  const DetectionResult r = calibrateAndDetect(sc, f, d);
-  ASSERT_TRUE(r.success) << r.message;
-  EXPECT_EQ(r.sherds.size(), 2u);
-  ASSERT_EQ(r.leftovers.size(), 1u);
-  const Leftover& l = r.leftovers[0];
+  Leftover l;
+  ASSERT_NO_FATAL_FAILURE(theOneLeftover(sc, l));
   EXPECT_TRUE(l.on_edge) << l.why;
   EXPECT_NE(l.why.find("edge"), std::string::npos) << l.why;
   EXPECT_LT((l.position.head<2>() - sc.sherds[0].pose.head<2>()).norm(), 0.008) << l.position.transpose();

@@ -189,8 +189,11 @@ def test_a_standing_sherd_falls_towards_the_middle_of_the_mat_and_away_from_othe
     turned = Leftover(cx, cy, 0.05, 0.007, "", 0.0, math.pi / 2, 0.04, True)
     assert abs(topple_direction(turned, [], area)[1]) == pytest.approx(0.0, abs=1e-9)  # across x
     # as tall as the mat is narrow: it would fall off whichever way
-    tall = Leftover(cx, cy, 0.05, 0.007, "", 0.0, 0.0, 2 * sy, True)
+    tall = Leftover(cx, cy, 0.05, 0.007, "", 0.0, 0.0, sy, True)
     assert topple_direction(tall, [], area) is None
+    # standing astride the mat's edge (a heap run left one 8 mm inside it): laid inwards
+    astride = Leftover(cx, cy - sy / 2 + 0.008, 0.05, 0.012, "", 0.0, 0.0, 0.033, True)
+    assert topple_direction(astride, [], area) == pytest.approx((0.0, 1.0))
 
 
 def test_a_sherd_that_slips_out_while_lifted_and_vanishes_is_said(config):

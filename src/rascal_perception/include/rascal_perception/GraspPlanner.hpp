@@ -54,11 +54,13 @@ class GraspPlanner {
   void score(std::vector<SherdDetection>& sherds) const;
   double minOpening() const { return config_.gripper.minOpening(); }  ///< [m]
   double maxOpening() const { return config_.gripper.maxOpening(); }  ///< [m]
+  /// [m] a sherd may be this much narrower at the fingertips' height than its outline (the
+  /// depth camera's millimetre, a tapering edge)
+  static constexpr double kChordAllowance = 0.001;
   /// [m] the least chord across the fingers that they can be told to hold: closed on anything
   /// narrower they stop within held_margin of shut, which the gripper reads as empty (the
-  /// wx250s's fingers close to 30 mm apart). Twice the margin, so a sherd that is pressed a
-  /// little or narrower at the fingertips' height still reads as held.
-  double holdableChord() const { return minOpening() + 2.0 * config_.held_margin; }
+  /// wx250s's fingers close to 30 mm apart).
+  double holdableChord() const { return minOpening() + config_.held_margin + kChordAllowance; }
 
  private:
   /// [m] fingertip height above the plane minus what lies under the fingers' footprints.

@@ -41,18 +41,23 @@ def push_direction(
     """The unit direction (dx, dy) to push `o` in: where it ends farthest from its neighbours'
     outlines, its own outline still `EDGE` inside `area` (a config.Rect); None if no push
     keeps it on the mat."""
+    directions = [
+        (math.cos(2 * math.pi * k / DIRECTIONS), math.sin(2 * math.pi * k / DIRECTIONS))
+        for k in range(DIRECTIONS)
+    ]
+    return _roomiest(o, directions, PUSH, o.length / 2 + EDGE, others, area)
+
+
+def _roomiest(it, directions, travel, half, others, area) -> Optional[Tuple[float, float]]:
+    """Of `directions`, the one that moves `it` by `travel` farthest from the outlines of
+    `others` (their centres less half their length), `half` of it still inside `area`."""
     best, best_room = None, -math.inf
-    half = o.length / 2 + EDGE
-    for k in range(DIRECTIONS):
-        a = 2 * math.pi * k / DIRECTIONS
-        d = (math.cos(a), math.sin(a))
-        end = (o.x + PUSH * d[0], o.y + PUSH * d[1])
-        if any(
-            abs(end[i] - area.center[i]) > area.size[i] / 2 - half for i in (0, 1)
-        ):  # would leave the mat
-            continue
+    for d in directions:
+        end = (it.x + travel * d[0], it.y + travel * d[1])
+        if any(abs(end[i] - area.center[i]) > area.size[i] / 2 - half for i in (0, 1)):
+            continue  # would leave the mat
         room = min(
-            (math.hypot(end[0] - p.x, end[1] - p.y) - p.length / 2 for p in others if p is not o),
+            (math.hypot(end[0] - p.x, end[1] - p.y) - p.length / 2 for p in others if p is not it),
             default=1.0,
         )
         if room > best_room + 1e-9:
@@ -81,22 +86,12 @@ def was_pushed(b, o: Observation) -> bool:
 
 def topple_direction(lo: Leftover, others: List[Leftover], area) -> Optional[Tuple[float, float]]:
     """Which way to push a sherd standing on its edge over: of the two directions across its
-    long side, the one it falls farthest from `others`, lying flat (its length along, its
-    height across) still `EDGE` inside `area` (a config.Rect); None if neither keeps it there."""
-    best, best_room = None, -math.inf
-    half = max(lo.length, lo.height) / 2 + EDGE
-    for sign in (1.0, -1.0):
-        d = (-sign * math.sin(lo.yaw), sign * math.cos(lo.yaw))
-        end = (lo.x + d[0] * lo.height / 2, lo.y + d[1] * lo.height / 2)
-        if any(abs(end[i] - area.center[i]) > area.size[i] / 2 - half for i in (0, 1)):
-            continue
-        room = min(
-            (math.hypot(end[0] - p.x, end[1] - p.y) - p.length / 2 for p in others if p is not lo),
-            default=1.0,
-        )
-        if room > best_room + 1e-9:
-            best, best_room = d, room
-    return best
+    long side, the one where it lands farther from `others`, its far edge (a height beyond
+    where it stands: it tips about its foot) still `EDGE` inside `area` (a config.Rect); None
+    if neither. Its near side stays where it stood, so one standing at the mat's edge is laid
+    inwards, never further off."""
+    across = [(-sign * math.sin(lo.yaw), sign * math.cos(lo.yaw)) for sign in (1.0, -1.0)]
+    return _roomiest(lo, across, lo.height, EDGE, others, area)
 
 
 def topple(b, lo: Leftover, d: Tuple[float, float]) -> bool:
