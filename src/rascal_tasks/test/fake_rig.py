@@ -41,9 +41,6 @@ class Sherd:
     # sweep of the fingers through it below its top lays it flat, unless it is `wedged`
     standing: bool = False
     wedged: bool = False
-    # the chord its grasp closes on, when perception turns the grasp off its minor axis (to
-    # clear a neighbour): the fingers must open wider than this, or they land on it
-    chord: Optional[float] = None
 
 
 class World:
@@ -75,7 +72,6 @@ class World:
         # set down together on the mat, the two stay one on the other (else they fall apart)
         self.stay_stacked = False
         self.held_extra: Optional[Sherd] = None
-        self.opened = 0.074  # [m] the gripper's last opening
 
     def station_at(self, x, y):
         for st in self.config.stations.values():
@@ -147,7 +143,6 @@ class _Gripper(rig.Gripper):
         self.w = world
 
     def open(self, width=None):
-        self.w.opened = width if width else 0.074
         if self.w.held is not None:
             s, self.w.held = self.w.held, None
             x, y = self.w.at[:2]
@@ -170,8 +165,6 @@ class _Gripper(rig.Gripper):
         st = self.w.station_at(x, y)
         lying = self.w.lying(st.name if st else None)
         for s in sorted(lying, key=lambda s: -s.support):  # the top one of a stack
-            if s.chord is not None and self.w.opened < s.chord:
-                continue  # a finger came down on it
             if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.support + s.height:
                 self.w.held, self.w.grasped_at = s, (x, y)
                 partner = self.w.doubles.pop(s.name, None)
@@ -253,7 +246,7 @@ class _Perception(rig.Perception):
                 s.y,
                 surface + s.support + GRASP_ABOVE,
                 0.0,
-                (s.chord or s.width) + 0.012,
+                s.width + 0.012,
                 thickness=s.thickness,
                 support=s.support,
             )

@@ -137,16 +137,6 @@ def test_a_chip_too_small_to_pick_is_left_and_said_not_finished_silently(config)
     assert "12 x 9 mm at (0.250, 0.300) m" in describe_leftover(batch.leftovers[0])
 
 
-def test_a_sherd_grasped_on_a_turned_chord_is_taken_again_blind_as_wide(config):
-    # perception turned its grasp to clear a neighbour: the fingers closed on a 48 mm chord of a
-    # 30 mm wide sherd; at the scale and the camera it is picked again as it was held
-    world = World(config, [Sherd("a", 0.10, 0.22, 0.05, 0.03, chord=0.048)])
-    outcome, batch, rec = _run(config, world)
-    assert outcome == "finished"
-    assert rec.status() == {1: "done"}
-    assert world.opened >= 0.048  # opened as wide as it was held, at every station
-
-
 def test_a_sherd_standing_on_its_edge_is_pushed_over_and_recorded(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, standing=True)])
     outcome, batch, rec = _run(config, world)

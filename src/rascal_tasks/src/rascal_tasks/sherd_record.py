@@ -23,10 +23,7 @@ class SherdRecord:
         self.observation: Optional[Observation] = None  # its detection (for its likeness)
         self.grasp_yaw = 0.0
         self.grasp_height = 0.0  # ee height above the surface when closing
-        self.width = 0.0  # across its minor axis (m)
-        # the opening its last grasp approached with (m): a grasp turned off the minor axis (to
-        # clear a neighbour) closes on a longer chord than `width`; 0: not known (a resume)
-        self.opening = 0.0
+        self.width = 0.0  # across the fingers (m)
         self.station_index = -1  # last station done (-1: none yet)
         self.where = "pickup"  # station it was last seen at
         self.last_xy: Tuple[float, float] = (0.0, 0.0)
@@ -74,7 +71,7 @@ class SherdRecord:
 
     def grasped_as(self, o: Observation, station):
         """The next grasp follows the detection `o` on `station`."""
-        self.grasp_yaw, self.width, self.opening = o.grasp_yaw, o.width, o.grasp_width
+        self.grasp_yaw, self.width = o.grasp_yaw, o.width
         # (above the station's surface: for a sherd taken from the top of a heap this includes
         # what it lay on; handling it above its own support instead gave more drops in two heap
         # runs, so it is not changed until that is understood: see the README's heap row)

@@ -62,7 +62,7 @@ class Place(BatchState):
             z = st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
             b.move_down(*st.place_at, z, yaw, linear=True)
         with b.phase("grasping"):
-            b.rig.gripper.open(opening_around(b, s))
+            b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
         if plugin.hover_after_place:
             b.move_down(*st.place_at, z + b.config["arm"]["approach_offset"], yaw, linear=True)
         elif not plugin.release_from_above:
@@ -111,12 +111,6 @@ class AtStation(BatchState):
         return "done"
 
 
-def opening_around(b, s) -> float:
-    """How wide to open the fingers around sherd `s` as it was grasped: its grasp's opening
-    (a turned grasp closes on a chord longer than its width), else its width and the margin."""
-    return s.opening if s.opening > 0 else opening_for(s.width, b.config["arm"]["grasp_margin"])
-
-
 class Repick(BatchState):
     """Pick the sherd up again where it was placed; re-detect it if the blind grasp misses."""
 
@@ -151,7 +145,7 @@ def repick(b, index) -> bool:
         y,
         st.surface_z + s.grasp_height,
         s.grasp_yaw,
-        opening_around(b, s),
+        opening_for(s.width, b.config["arm"]["grasp_margin"]),
     )
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
         if grasp(b, o, st):
@@ -239,16 +233,14 @@ class PutBack(BatchState):
         b = self.batch
         s = b.sherd
         if held is None:
-            yaw, height = s.grasp_yaw, s.grasp_height
-            opening = opening_around(b, s)
+            yaw, height, width = s.grasp_yaw, s.grasp_height, s.width
         else:
-            yaw, height = held.grasp_yaw, held.grasp_z - b.pickup.surface_z
-            opening = opening_for(held.grasp_width, 0.0)
+            yaw, height, width = held.grasp_yaw, held.grasp_z - b.pickup.surface_z, held.width
         b.move_down(x, y, b.travel_z(), yaw)
         low = b.pickup.surface_z + height + b.config["arm"]["place_clearance"]
         b.move_down(x, y, low, yaw, linear=True)
         with b.phase("grasping"):
-            b.rig.gripper.open(opening)
+            b.rig.gripper.open(opening_for(width, b.config["arm"]["grasp_margin"]))
         b.move_down(x, y, b.travel_z(), yaw, linear=True)
 
 
