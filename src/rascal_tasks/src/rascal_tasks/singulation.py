@@ -31,8 +31,8 @@ PUSHED_NEAR = 0.025  # [m] a pushed sherd lies about this near where the push se
 TOPPLE_AT = 0.75  # of a standing sherd's height: where the finger pushes it
 FINGERTIP = urdf_model.fingertip_offset()  # [m] fingertips below ee_gripper_link
 # [m] ee_gripper_link to the leading finger's outer face, fingers closed and in line with a push
-# (half the closed opening, then the finger's 8 mm: the URDF's finger box)
-FINGER_REACH = urdf_model.opening_limits()[0] / 2 + 0.008
+# (half the closed opening, then the finger's thickness: the URDF's finger box)
+FINGER_REACH = urdf_model.opening_limits()[0] / 2 + urdf_model.finger_thickness()
 
 
 def push_direction(

@@ -111,14 +111,25 @@ def camera_offset(urdf_xml: Optional[str] = None) -> float:
     return _origin("camera_mount", urdf_xml)[2]
 
 
-def fingertip_offset(urdf_xml: Optional[str] = None) -> float:
-    """How far the fingertips reach below ee_gripper_link with the gripper pointing down, metres:
-    the far end of left_finger_link's collision box along the approach axis, from the ee_gripper
-    joint (as rascal_workcell::GripperGeometry reads it; 4.4 mm on the wx250s)."""
+def _finger_box(urdf_xml: Optional[str]):
+    """left_finger_link's collision box: (its origin's x, its size [x, y, z]), metres."""
     link = _robot(urdf_xml).find("link[@name='left_finger_link']/collision")
     box = link.find("geometry/box") if link is not None else None
     if box is None:
         raise ValueError("URDF: left_finger_link needs a box collision")
     origin = link.find("origin")
     x = float(origin.get("xyz").split()[0]) if origin is not None else 0.0
-    return x + float(box.get("size").split()[0]) / 2 - _origin("ee_gripper", urdf_xml)[0]
+    return x, [float(v) for v in box.get("size").split()]
+
+
+def fingertip_offset(urdf_xml: Optional[str] = None) -> float:
+    """How far the fingertips reach below ee_gripper_link with the gripper pointing down, metres:
+    the far end of left_finger_link's collision box along the approach axis, from the ee_gripper
+    joint (as rascal_workcell::GripperGeometry reads it; 4.4 mm on the wx250s)."""
+    x, size = _finger_box(urdf_xml)
+    return x + size[0] / 2 - _origin("ee_gripper", urdf_xml)[0]
+
+
+def finger_thickness(urdf_xml: Optional[str] = None) -> float:
+    """A finger's thickness along the closing direction, metres (its box's y; 8 mm)."""
+    return _finger_box(urdf_xml)[1][1]
