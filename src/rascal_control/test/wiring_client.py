@@ -12,7 +12,7 @@ import rospy
 from sensor_msgs.msg import JointState
 
 from rascal_control import Arm, ControlError, Gripper
-from rascal_control.deadline import Deadline
+from rascal_control.deadline import DONE, Deadline, wait_for
 
 ARM = ("waist", "shoulder", "elbow", "forearm_roll", "wrist_angle", "wrist_rotate")
 
@@ -113,6 +113,12 @@ def cancel(arm):
         speed_scale=0.3,
     )
     client.send_goal(goal)
+    # cancelled only once the controller has taken it and is moving (see GoalRunner.acknowledged)
+    moving = wait_for(
+        lambda: client.acknowledged() and client.feedback is not None,
+        Deadline(10.0, rospy.get_time),
+    )
+    assert moving == DONE, "the goal was not taken within 10 s: " + moving
     rospy.sleep(0.6)
     client.cancel_goal()
     client.wait_for_result(Deadline(10.0, rospy.get_time))

@@ -168,6 +168,16 @@ class GoalRunner:
 
         return wait_for(done, deadline, stop, self.server_alive, sleep=self._done.wait)
 
+    def acknowledged(self) -> bool:
+        """Whether the server's status has listed the goal. (A goal cancelled before that is
+        marked LOST by actionlib when the next status lacks it, and its result is dropped.)"""
+        if self._gh is None:
+            return False
+        return self._gh.get_comm_state() not in (
+            self._actionlib.CommState.WAITING_FOR_GOAL_ACK,
+            self._actionlib.CommState.WAITING_FOR_CANCEL_ACK,
+        )
+
     def get_result(self):
         return self._gh.get_result() if self._gh is not None else None
 
