@@ -297,3 +297,63 @@ def test_after_a_restart_a_sherd_lying_on_the_scale(station):
     t = world.t
     assert plugin.after_place(other) == "done" and world.t == t  # not weighed on that zero
     assert recorder.sherds[other.seq].status == "mass_unstable"
+
+
+# -- the tare done while the arm is away ---------------------------------------------------------
+def test_a_pan_tared_while_the_arm_was_away_is_not_tared_again_nor_waited_for(station):
+    plugin, sherd, scale, world, recorder, _ = station
+    plugin.while_away()  # the arm at the camera: the pan has read 0 steadily
+    plugin.while_away()  # and at the discard box: once is enough
+    assert len(scale.tares) == 1
+    world.t += 6.0  # the next sherd is picked up and carried over the scale
+    t = world.t
+    plugin.before_place(sherd)
+    assert len(scale.tares) == 1 and world.t == t  # no tare, no wait above the scale
+    _place(world, scale)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)
+    assert not _notes(recorder, "pan_loaded")
+    # the next sherd needs a tare of its own
+    plugin.before_place(sherd)
+    assert len(scale.tares) == 2
+
+
+def test_a_pan_still_swinging_is_not_tared_while_the_arm_is_away(station):
+    plugin, sherd, scale, world, recorder, _ = station
+    quiet_from = world.t + 2.0
+    scale.load = lambda t: 0.002 * math.sin(5.0 * t) if t < quiet_from else 0.0
+    plugin.while_away()
+    assert scale.tares == []
+    world.t += 6.0
+    plugin.before_place(sherd)  # tared above the scale, as before
+    assert len(scale.tares) == 1 and scale.tares[0][0] >= quiet_from
+
+
+def test_an_early_tare_that_no_longer_reads_zero_is_done_again_above_the_scale(station):
+    # something landed on the pan after the early tare (a sherd that slipped over it), or the
+    # early tare caught the platform swinging: the pan is tared again with the sherd above it
+    plugin, sherd, scale, world, recorder, _ = station
+    plugin.while_away()
+    world.t += 3.0
+    landed = world.t
+    scale.load = lambda t: 0.0207 if t >= landed else 0.0
+    world.t += 3.0
+    plugin.before_place(sherd)
+    assert len(scale.tares) == 2
+    _place(world, scale)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)
+    (note,) = _notes(recorder, "pan_loaded")  # said, as for any pan found loaded
+    assert "the empty pan read 20.7 g before the tare" in note, note
+
+
+def test_an_early_tare_that_caught_the_platform_swinging_is_redone(station):
+    plugin, sherd, scale, world, recorder, _ = station
+    scale.unsettled_tares = 1
+    plugin.while_away()
+    world.t += 6.0
+    plugin.before_place(sherd)
+    assert len(scale.tares) == 2
+    _place(world, scale)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)  # not 3 g low

@@ -8,10 +8,11 @@ own IK, with the wrist turned the least (yaw along the arm: a symmetric grasp); 
 strokes only as wide as the grasp margin; the stations' own times from the simulator's models
 (the scale's settling, the camera's shutter and transfer). Two figures:
 
-- `serial`: that sequence with every wait in series, as the workflow runs it today (the tare's
-  settle before placing, the whole capture with the arm at standby);
+- `serial`: that sequence with every wait in series, as the workflow runs it today (the whole
+  capture with the arm at standby; the tare is done while the arm is at the later stations,
+  `ScaleStation.while_away`);
 - `bound`: the same moves with only what cannot overlap arm motion (the loaded scale settling
-  while the arm hovers, the shutter): no planner margin, no tare wait, no transfer wait.
+  while the arm hovers, the shutter): no planner margin, no transfer wait.
 
 Pickup spots are averaged over a grid of the pickup area; the lawnmower survey is shared by the
 batch's sherds. No ROS here: `rosrun rascal_tasks layout_bound` (scripts/) gives `bound_of` the
@@ -93,8 +94,7 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float]) -> List[Step]:
             continue
         z = st.surface_z + GRASP_HEIGHT + arm["place_clearance"]
         if st.type == "scale":
-            # today the tare waits a stable window before the sherd is placed
-            steps.append(Step("over scale", (x, y, travel), serial_wait=scale["stable_window"]))
+            steps.append(Step("over scale", (x, y, travel)))  # tared while the arm was away
             steps.append(Step("place on scale", (x, y, z), wait=margin_stroke))
             settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
             steps.append(Step("hover", (x, y, z + approach), wait=settle))  # while it settles

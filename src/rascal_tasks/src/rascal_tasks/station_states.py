@@ -89,6 +89,8 @@ class AtStation(BatchState):
         b = self.batch
         plugin = b.plugins[self.index]
         s = b.sherd
+        for earlier in b.plugins[: self.index]:
+            earlier.while_away()
         if plugin.station.type == "archival_camera":
             # the photo's analysis learns the chart's and bar's sizes (not where they lie)
             use = getattr(b.recorder, "use_archival_station", None)

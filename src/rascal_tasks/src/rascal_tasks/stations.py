@@ -65,6 +65,11 @@ class StationPlugin:
         """Called with the sherd (a SherdRecord) in the gripper above the station (e.g. tare
         the scale)."""
 
+    def while_away(self) -> None:
+        """Called while the arm works at a later station, the sherd gone from this one: a
+        station may start here, without waiting, what its next sherd needs (the scale tares its
+        empty pan)."""
+
     def after_place(self, sherd) -> str:
         """Called with the sherd placed and the gripper back at travel height; records what it
         measured through `sherd` (SherdRecord). Returns 'done'; 'missing' when the sherd is
@@ -111,6 +116,7 @@ class ScaleStation(StationPlugin):
         super().__init__(station, batch)
         self._tared_for = None  # seq of the sherd the scale was tared (and checked) for
         self._before_tare = 0.0  # kg, what the settled empty pan read before the last tare
+        self._early_tare = None  # (clock time, empty reading before it) of while_away's tare
 
     def _cfg(self):
         return self.batch.config["scale"]
@@ -157,6 +163,44 @@ class ScaleStation(StationPlugin):
             last.mass * 1000,
         )
 
+    def _settled_now(self, since: float) -> Optional[ScaleReading]:
+        """The weighing rule on the readings since `since`, as they are now (no waiting)."""
+        cfg = self._cfg()
+        return settled(
+            self.batch.rig.scale.readings(since), cfg["stable_window"], cfg["readability"]
+        )
+
+    def while_away(self):
+        """Tares the empty pan while the arm is at the next stations (it takes a whole stable
+        window after the tare to check it: that wait was spent standing above the scale with
+        the next sherd). Only a pan that has read steady for a whole window is tared; otherwise
+        the next sherd's tare is done above the scale as before."""
+        if self._early_tare is not None:
+            return
+        b, cfg = self.batch, self._cfg()
+        empty = self._settled_now(b.rig.clock.now() - cfg["stable_window"] - 1.0)
+        if empty is None:
+            return
+        try:
+            b.rig.scale.tare()
+        except RigError as e:  # tared again, and said, when the next sherd is above the scale
+            b.log("early tare of the scale failed: %s" % e)
+            return
+        self._early_tare = (b.rig.clock.now(), empty.mass)
+
+    def _early_tare_holds(self) -> bool:
+        """Whether while_away's tare (if any) still holds: since it, the pan has read zero
+        within the readability for a whole window. Used once: a sherd placed after it needs a
+        tare of its own."""
+        early, self._early_tare = self._early_tare, None
+        if early is None:
+            return False
+        zero = self._settled_now(early[0])
+        if zero is None or abs(zero.mass) > self._cfg()["readability"] + 1e-9:
+            return False
+        self._before_tare = early[1]
+        return True
+
     def _tare_once(self) -> Optional[str]:
         """Tare after a settled empty reading, then check it; None when it took, else why not."""
         b, cfg = self.batch, self._cfg()
@@ -176,25 +220,31 @@ class ScaleStation(StationPlugin):
     def before_place(self, sherd):
         self._tared_for = None
         b = self.batch
+        if self._early_tare_holds():
+            self._tared(sherd)
+            return
         with b.phase("data_collection"):
             for attempt in range(1 + self._cfg()["rereads"]):
                 problem = self._tare_once()
                 if problem is None:
-                    self._tared_for = sherd.seq
-                    if self._before_tare >= MIN_SHERD_MASS:
-                        # a sherd the wrist camera did not see there (or a zero that moved): the
-                        # tare takes it away, but the archaeologist is told, on this row
-                        b.event(
-                            sherd,
-                            "pan_loaded",
-                            "the empty pan read %.1f g before the tare for this sherd: something "
-                            "lies on the scale (or its zero moved); weighed tared over it"
-                            % (self._before_tare * 1000),
-                        )
+                    self._tared(sherd)
                     return
                 b.event(sherd, "tare_failed", "attempt %d: %s" % (attempt + 1, problem))
         # Recorded before placing: a restart that finds it lying on the scale does not weigh it.
         self._mass_unstable(sherd, "the scale could not be tared (%s)" % problem)
+
+    def _tared(self, sherd):
+        """The pan is tared and checked for `sherd`."""
+        self._tared_for = sherd.seq
+        if self._before_tare >= MIN_SHERD_MASS:
+            # a sherd the wrist camera did not see there (or a zero that moved): the tare takes
+            # it away, but the archaeologist is told, on this row
+            self.batch.event(
+                sherd,
+                "pan_loaded",
+                "the empty pan read %.1f g before the tare for this sherd: something lies on "
+                "the scale (or its zero moved); weighed tared over it" % (self._before_tare * 1000),
+            )
 
     def after_place(self, sherd):
         b, cfg = self.batch, self._cfg()
