@@ -26,14 +26,6 @@ def ik(x, y, z, seed):
     return [math.atan2(y, x), 4.0 * (r - 0.3), -4.0 * (r - 0.3) + 3.0 * z, 0.0, 3.0 * z, 0.0]
 
 
-def test_trapezoid_at_the_servo_limits():
-    # short: triangular, 2 sqrt(d/a); long: cruise at pi rad/s
-    assert lb.trapezoid(0.5) == pytest.approx(2 * math.sqrt(0.5 / 5.0))
-    assert lb.trapezoid(-3.0) == pytest.approx(3.0 / math.pi + math.pi / 5.0)
-    assert lb.trapezoid(0.0) == 0.0
-    assert lb.move_time([0, 0, 0], [0.1, -2.0, 0.3]) == pytest.approx(lb.trapezoid(2.0))
-
-
 def test_the_scale_settles_later_for_heavier_sherds_and_longer_windows():
     light = lb.scale_settle(0.005, 1.0, 1e-4)
     heavy = lb.scale_settle(0.060, 1.0, 1e-4)

@@ -47,6 +47,7 @@ class Batch:
         self.state_times = {}  # state label -> seconds, for the summary and the benchmark
         self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
         self.misses = {}  # rounded (x, y) -> pickups that failed there
+        self.last_pose = None  # (x, y, yaw) of the last top-down move (wrist.route_yaw)
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
         self.lift_slips: List[Observation] = []  # grasped sherds that slipped out while lifted
         self.unchecked_slips: List[Observation] = []  # ... not yet looked for by a survey
@@ -99,8 +100,10 @@ class Batch:
 
     def move_down(self, x, y, z, yaw, linear=False):
         self.check_stop()
+        self.last_pose = None  # unknown until the arm got there
         with self.phase("locomotion"):
             self.rig.arm.move_down(x, y, z, yaw, linear=linear)
+        self.last_pose = (x, y, yaw)
 
     def travel_z(self) -> float:
         return self.config["arm"]["travel_z"]

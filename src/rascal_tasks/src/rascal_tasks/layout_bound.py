@@ -21,15 +21,12 @@ arm controller's IK.
 
 import math
 from dataclasses import dataclass
-from typing import Callable, Dict, List, Sequence, Tuple
+from typing import Callable, Dict, List, Tuple
 
 from rascal_tasks.config import Config
+from rascal_tasks.joint_motion import move_time
 from rascal_tasks.survey import CAMERA_OFFSET, lawnmower
 
-# facts/timing.md (the simulator enforces these; the servos' Velocity_Limit and the arm's
-# MoveIt acceleration limit)
-MAX_SPEED = math.pi  # [rad/s]
-MAX_ACCELERATION = 5.0  # [rad/s^2]
 # rascal_sim ScaleSensor (timing.md): first-order settling, readings every 0.1 s
 SCALE_TIME_CONSTANT = 0.3  # [s]
 SCALE_PERIOD = 0.1  # [s]
@@ -41,19 +38,6 @@ TRANSFER = 1.5  # [s] image download after the shutter; the arm may move meanwhi
 TYPICAL_MASS = 0.02  # [kg]
 GRASP_HEIGHT = 0.008  # [m] ee_gripper_link above the surface when closing
 PICKUP_GRID = (5, 3)  # pickup spots averaged over, along x and y
-
-
-def trapezoid(distance: float, speed: float = MAX_SPEED, acc: float = MAX_ACCELERATION) -> float:
-    """Least time to travel `distance` [rad] from rest to rest within `speed` and `acc`."""
-    d = abs(distance)
-    if d <= speed * speed / acc:
-        return 2.0 * math.sqrt(d / acc)
-    return d / speed + speed / acc
-
-
-def move_time(q0: Sequence[float], q1: Sequence[float]) -> float:
-    """A joint move synchronised to its slowest joint."""
-    return max(trapezoid(b - a) for a, b in zip(q0, q1, strict=True))
 
 
 def scale_settle(mass: float, window: float, readability: float) -> float:

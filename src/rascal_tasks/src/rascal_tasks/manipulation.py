@@ -3,12 +3,14 @@ sherd up (pickup, repick, recovery, resume). No ROS in here.
 """
 
 import contextlib
+import dataclasses
 
 from rascal_workcell import urdf_model
 
 from rascal_tasks.failures import SherdFailure, about_this_sherd
 from rascal_tasks.rig import Observation, RigError
 from rascal_tasks.survey import survey_at
+from rascal_tasks.wrist import route_yaw
 
 # Opening between the fingertips, from the URDF's finger limits (facts §1.4: 30..74 mm).
 MIN_OPENING, MAX_OPENING = urdf_model.opening_limits()
@@ -62,6 +64,11 @@ def grasp_retrying(b, o: Observation, station, like=None):
     rec = b.config["recovery"]
     like = like or (lambda c, last: c.distance_to(last.x, last.y))
     for attempt in range(rec["max_grasp_attempts"]):
+        if station is b.pickup:  # the grasp turned by pi is the same grasp
+            route = [p.station for p in b.plugins]
+            yaw = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
+            if yaw != o.grasp_yaw:
+                o = dataclasses.replace(o, grasp_yaw=yaw)
         if grasp(b, o, station):
             return o, attempt + 1, True
         if attempt + 1 == rec["max_grasp_attempts"]:

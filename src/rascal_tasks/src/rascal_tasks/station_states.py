@@ -9,16 +9,11 @@ from rascal_tasks.manipulation import grasp, opening_for
 from rascal_tasks.rig import Observation
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
+from rascal_tasks.wrist import station_yaw
 
 # [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
 # another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
 STACKED = 0.002
-
-
-def place_yaw(station, sherd) -> float:
-    """The gripper's yaw at a station: the taught one (`rascal teach`), else as picked up (no
-    wrist turn on the way)."""
-    return sherd.grasp_yaw if station.place_yaw is None else station.place_yaw
 
 
 class Translate(BatchState):
@@ -34,7 +29,7 @@ class Translate(BatchState):
     def run(self):
         b = self.batch
         st = b.plugins[self.index].target(b.sherd)
-        b.move_down(*st.place_at, b.travel_z(), place_yaw(st, b.sherd))
+        b.move_down(*st.place_at, b.travel_z(), station_yaw(b.config, st, b.sherd.grasp_yaw))
         if not b.rig.gripper.holding():
             b.sherd.dropped("while carrying to %s" % st.name)
             return "dropped"
@@ -57,7 +52,7 @@ class Place(BatchState):
         s = b.sherd
         st = plugin.target(s)
         plugin.before_place(s)
-        yaw = place_yaw(st, s)
+        yaw = station_yaw(b.config, st, s.grasp_yaw)
         if not plugin.release_from_above:
             z = st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
             b.move_down(*st.place_at, z, yaw, linear=True)

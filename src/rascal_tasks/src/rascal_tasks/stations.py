@@ -7,13 +7,13 @@ No ROS here: plug-ins use the rig interfaces (`rig.py`) and write through the sh
 (`sherd_record.py`).
 """
 
-import math
 import os
 from typing import Dict, List, Optional, Tuple, Type
 
 from rascal_tasks.archival import exposure
 from rascal_tasks.archival.exposure import Exposure
 from rascal_tasks.rig import RigError, ScaleReading
+from rascal_tasks.wrist import standby_yaw
 
 STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
 # The smallest sherd worth recording: 2 x 2 cm, 4 mm wall at 1.8 g/cm^3 is about 2.9 g
@@ -334,10 +334,8 @@ class ArchivalCameraStation(StationPlugin):
     def after_place(self, sherd):
         b = self.batch
         sx, sy = b.config["arm"]["standby"]
-        # Turn the wrist so the wrist camera (mounted ahead of the gripper) faces away from the
-        # archival camera's view too.
-        cx, cy = self.station.area.center
-        b.move_down(sx, sy, b.config["arm"]["travel_z"], math.atan2(sy - cy, sx - cx))
+        # the wrist camera faces away from the view too (the sherd was set down turned so)
+        b.move_down(sx, sy, b.config["arm"]["travel_z"], standby_yaw(b.config, self.station))
         with b.phase("data_collection"):
             capture = self._capture(sherd, sherd.spool_path())
             if capture is None:
