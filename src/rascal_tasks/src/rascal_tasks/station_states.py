@@ -58,8 +58,9 @@ class Place(BatchState):
             b.move_down(*st.place_at, z, yaw, linear=True)
         with b.phase("grasping"):
             b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
-        if plugin.hover_after_place:
-            b.move_down(*st.place_at, z + b.config["arm"]["approach_offset"], yaw, linear=True)
+        if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)
+            hover = st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
+            b.move_down(*st.place_at, hover, yaw, linear=True)
         elif not plugin.release_from_above:
             b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
         s.placed(st, yaw)
