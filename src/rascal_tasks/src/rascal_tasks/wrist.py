@@ -5,7 +5,7 @@ For a top-down pose the arm's IK gives wrist_rotate = waist - yaw, with the wais
 turn of the wrist costs nothing while the waist turns as far, and up to 1.3 s where the arm
 barely moves (the archival camera's standby beside its spot). Measured with bench/throughput
 (seed 10): a sherd's moves took 11.0 s, of which the turn to the standby and back 2.6 s and a
-3.9 rad turn from one sherd's yaw to the next's 0.8 s more than the waist's own move.
+4.4 rad turn from one sherd's yaw to the next's 0.8 s more than the waist's own move.
 
 Two choices remove most of it:
 - the fingers are alike, so a grasp at yaw g is the grasp at g + pi: the pickup's grasp yaw is
