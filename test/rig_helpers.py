@@ -114,17 +114,30 @@ def rows(dsn, context):
         return cur.fetchall()
 
 
-def run_until_weighed(rig, db, context, timeout=600):
-    """`rascal run --context CONTEXT` started; returned, still running, as soon as its first sherd
-    is recorded weighed (it then lies on the scale, or is being lifted off it)."""
+def run_until(rig, db, context, reached, what, timeout=600):
+    """`rascal run --context CONTEXT` started; returned, still running, as soon as
+    `reached(rows of CONTEXT)` is true (polled every 50 ms)."""
     proc = rig.rascal("--dsn", db, "run", "--context", context)
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline and proc.poll() is None:
-        if any(r["status"] == "weighed" for r in rows(db, context)):
+        if reached(rows(db, context)):
             break
         time.sleep(0.05)
-    assert proc.poll() is None, "the batch ended before a sherd was weighed"
+    assert proc.poll() is None, "the batch ended before %s" % what
     return proc
+
+
+def run_until_weighed(rig, db, context, timeout=600):
+    """`rascal run --context CONTEXT` started; returned, still running, as soon as its first sherd
+    is recorded weighed (it then lies on the scale, or is being lifted off it)."""
+    return run_until(
+        rig,
+        db,
+        context,
+        lambda recorded: any(r["status"] == "weighed" for r in recorded),
+        "a sherd was weighed",
+        timeout,
+    )
 
 
 def call(rig, code):

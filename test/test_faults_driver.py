@@ -27,9 +27,21 @@ import time
 
 import pytest
 import yaml
-from rig_helpers import SMALL, WORKSPACE, ground_truth, rows, run_batch, run_until_weighed
+from rig_helpers import (
+    SMALL,
+    WORKSPACE,
+    ground_truth,
+    inject,
+    rows,
+    run_batch,
+    run_until,
+    run_until_weighed,
+)
 
 pytestmark = [pytest.mark.faults, pytest.mark.timeout(900)]
+
+# rascal_msgs/srv/InjectFault.srv
+SCALE_GLITCH_ON_LOAD = 4  # garbage, unstable readings from when the next sherd lands
 
 # What the run's one error line says about the arm driver (arm_controller's words).
 DRIVER_FAULT = (
@@ -266,14 +278,27 @@ def test_a_killed_arm_controller_stops_the_run_in_bounded_time_and_a_rerun_finis
 def test_a_restarted_detector_finds_the_sherd_a_killed_run_left_on_the_scale(
     rig_factory, db, tmp_path
 ):
-    """The run and the detector die together while a weighed sherd lies on the scale (a laptop
-    crash). The restarted detector restores the backgrounds it had learnt (BackgroundStore), so
-    the rerun's Calibrate sees the sherd on the scale and keeps the scale's model instead of
+    """The run and the detector die together while a sherd lies on the scale (a laptop crash).
+    The restarted detector restores the backgrounds it had learnt (BackgroundStore), so the
+    rerun's Calibrate sees the sherd on the scale and keeps the scale's model instead of
     learning the sherd as background, and Resume carries on with it: each sherd recorded once.
-    Without the kept backgrounds that sherd was recorded lost and the next ones put on it."""
+    Without the kept backgrounds that sherd was recorded lost and the next ones put on it.
+
+    The kill must find the sherd lying there with the gripper away from it: the scale is made
+    to read unsteadily when the sherd lands (longer than one scale.stable_timeout of 4 s), and
+    the run is killed once its first reading was noted unsteady, while the arm hovers waiting
+    for the next (a kill as soon as the sherd is weighed raced the repick's descent)."""
     rig = rig_factory(archive=tmp_path / "archive", params={"/simulator/real_time_factor": 1.0})
     truth = ground_truth(rig)
-    proc = run_until_weighed(rig, db, "FAULT-DET")
+    ok, message = inject(rig, SCALE_GLITCH_ON_LOAD, 5.0)
+    assert ok, message
+    proc = run_until(
+        rig,
+        db,
+        "FAULT-DET",
+        lambda recorded: any("scale_unstable: attempt 1" in (r["notes"] or "") for r in recorded),
+        "a reading on the scale was noted unsteady",
+    )
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     kill(rig, "sherd_detector")
@@ -289,4 +314,5 @@ def test_a_restarted_detector_finds_the_sherd_a_killed_run_left_on_the_scale(
 
     out = rerun_finishes_once_each(rig, db, "FAULT-DET", truth)
     assert "sherd(s) lying at the scale: its background model from before is kept" in out, out
-    assert "sherd 1 was weighed" in out, out[-3000:]
+    assert "sherd 1 was picked" in out, out[-3000:]
+    assert "sherd 1 tare_unchecked: lying on the scale after a restart" in out, out[-3000:]
