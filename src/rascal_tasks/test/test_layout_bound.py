@@ -40,3 +40,13 @@ def test_the_bound_is_below_the_serial_sequence_and_grows_with_the_layout(data):
     far = copy.deepcopy(data)
     far["stations"]["discard"]["position"] = [-0.05, -0.38]  # the box farther round
     assert lb.bound_of(config_from_dict(far), ik)["motion"] > near["motion"]
+
+
+def test_every_pick_but_a_surveys_first_pays_for_a_look_at_the_sherd(data):
+    cfg = config_from_dict(data)
+    spot = cfg.stations["pickup"].area.center
+    looked = lb.sequence(cfg, spot)
+    assert looked[0].what == "look at the sherd"
+    assert looked[1:] == lb.sequence(cfg, spot, look=False)
+    # one sherd per survey: no look; ten: nine of ten pay for one
+    assert lb.bound_of(cfg, ik, 1)["motion"] < lb.bound_of(cfg, ik, 10)["motion"]

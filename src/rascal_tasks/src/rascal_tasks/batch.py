@@ -56,6 +56,7 @@ class Batch:
         self.pushed = set()  # rounded (x, y) where a sherd was pushed apart (singulation.py)
         self.pushed_to: List[tuple] = []  # ((x, y) where it should lie now, its Observation)
         self.pending: List[Observation] = []
+        self.pending_stale = False  # a grasp on the pickup mat since `pending` was surveyed
         self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
         self.put_back_doubles = {}  # seq -> times its grasp was put back as two sherds in one
         self.renumber: Optional[SherdRecord] = (

@@ -1,12 +1,12 @@
 """The physical bound of a station layout: the seconds one sherd takes at the arm's and the
 stations' limits, to set the measured seconds per sherd against (issue 18, item 2).
 
-Every move of the workflow's sequence (pickup, scale, archival camera with its standby, discard;
-approach, descent, lift at each) is timed as the synchronised trapezoid of its slowest joint at
-the servos' limits (facts/timing.md: pi rad/s, 5 rad/s^2) between joint vectors from the arm's
-own IK, with the wrist turned the least (yaw along the arm: a symmetric grasp); the gripper's
-strokes only as wide as the grasp margin; the stations' own times from the simulator's models
-(the scale's settling, the camera's shutter and transfer). Two figures:
+Every move of the workflow's sequence (a look at the sherd, pickup, scale, archival camera with
+its standby, discard; approach, descent, lift at each) is timed as the synchronised trapezoid
+of its slowest joint at the servos' limits (facts/timing.md: pi rad/s, 5 rad/s^2) between joint
+vectors from the arm's own IK, with the wrist turned the least (yaw along the arm: a symmetric
+grasp); the gripper's strokes only as wide as the grasp margin; the stations' own times from the
+simulator's models (the scale's settling, the camera's shutter and transfer). Two figures:
 
 - `serial`: that sequence with every wait in series, as the workflow runs it today (the whole
   capture with the arm at standby; the tare is done while the arm is at the later stations,
@@ -56,15 +56,18 @@ class Step:
     serial_wait: float = 0.0  # [s] more, in series, as the workflow runs today
 
 
-def sequence(cfg: Config, pickup_xy: Tuple[float, float]) -> List[Step]:
+def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> List[Step]:
     """The moves and waits of one sherd picked at `pickup_xy`, from the discard drop of the
-    sherd before to its own (the workflow's order: stations in config order)."""
+    sherd before to its own (the workflow's order: stations in config order). `look`: the
+    wrist camera looks at the sherd first (every pick but a survey's first, pickup.look_again)."""
     arm, scale = cfg["arm"], cfg["scale"]
     margin_stroke = arm["gripper"]["stroke_time"] * arm["grasp_margin"] / 0.044  # of 30..74 mm
     travel, approach = arm["travel_z"], arm["approach_offset"]
     steps: List[Step] = []
     px, py = pickup_xy
     z0 = cfg.stations["pickup"].surface_z + GRASP_HEIGHT
+    if look:
+        steps += camera_over_steps(cfg, [pickup_xy], "look at the sherd")
     steps += [
         Step("approach pickup", (px, py, z0 + approach), wait=margin_stroke),  # open on the way
         Step("descend", (px, py, z0), wait=margin_stroke),  # close
@@ -96,14 +99,21 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float]) -> List[Step]:
     return steps
 
 
-def survey_steps(cfg: Config) -> List[Step]:
+def camera_over_steps(cfg: Config, spots, what: str) -> List[Step]:
+    """The wrist camera over each of `spots` of the pickup area at the survey height."""
     st, sv = cfg.stations["pickup"], cfg["survey"]
     out = []
-    for x, y in lawnmower(st.area.center, st.area.size, sv["step"]):
+    for x, y in spots:
         yaw = math.atan2(y, x)
         ex, ey = x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw)
-        out.append(Step("survey", (ex, ey, st.surface_z + sv["z"]), wait=sv["settle_time"]))
+        out.append(Step(what, (ex, ey, st.surface_z + sv["z"]), wait=sv["settle_time"]))
     return out
+
+
+def survey_steps(cfg: Config) -> List[Step]:
+    st = cfg.stations["pickup"]
+    spots = lawnmower(st.area.center, st.area.size, cfg["survey"]["step"])
+    return camera_over_steps(cfg, spots, "survey")
 
 
 def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, list]:
@@ -132,11 +142,14 @@ def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str
     dx, dy = cfg.stations["discard"].place_at
     home = ik(dx, dy, cfg["arm"]["travel_z"], None)
     totals = {"motion": 0.0, "waits": 0.0, "serial_waits": 0.0}
+    # a survey's first sherd is grasped from the survey's detection, the others after a look
+    looked = (sherds_per_survey - 1) / max(1, sherds_per_survey)
     for spot in spots:
-        m, w, s, _ = timed(sequence(cfg, spot), ik, home)
-        totals["motion"] += m / len(spots)
-        totals["waits"] += w / len(spots)
-        totals["serial_waits"] += s / len(spots)
+        for look, share in ((True, looked), (False, 1.0 - looked)):
+            m, w, s, _ = timed(sequence(cfg, spot, look), ik, home)
+            totals["motion"] += share * m / len(spots)
+            totals["waits"] += share * w / len(spots)
+            totals["serial_waits"] += share * s / len(spots)
     m, w, _, q = timed(survey_steps(cfg), ik, home)
     m += move_time(q, home)
     totals["survey"] = (m + w) / max(1, sherds_per_survey)

@@ -2,11 +2,15 @@
 gripper, numbered. No ROS in here.
 """
 
+from typing import Optional
+
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
+from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
-from rascal_tasks.selection import same_size
+from rascal_tasks.selection import covered, same_size
+from rascal_tasks.survey import SAME_SHERD, survey_at
 
 
 class Pickup(BatchState):
@@ -19,8 +23,17 @@ class Pickup(BatchState):
 
     def run(self):
         b = self.batch
+        o = b.pending.pop(0)
+        if b.pending_stale:
+            # the mat changed since the survey (a grasp here): the sherd is grasped where the
+            # wrist camera sees it now, never where it lay before
+            o = look_again(b, o)
+            if o is None:
+                b.pending = []
+                return "missed"
+        b.pending_stale = True
         slips = len(b.lift_slips)
-        o, tries, held = grasp_retrying(b, b.pending.pop(0), b.pickup)
+        o, tries, held = grasp_retrying(b, o, b.pickup)
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
         # again (survey.account_for_slips), unless the retry took it at once
         b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
@@ -81,3 +94,24 @@ class Pickup(BatchState):
             "sherd at (%.3f, %.3f) m left in the pickup area: %s" % (o.x, o.y, failure.reason),
         )
         return "missed"
+
+
+def look_again(b, o: Observation) -> Optional[Observation]:
+    """The wrist camera over `o`, seen by an earlier survey: the detection nearest it now
+    (within recovery.search_radius: a neighbour's grasp may have nudged it), or None when
+    nothing pickable lies there any more (it was moved away, or now lies under another)."""
+    radius = b.config["recovery"]["search_radius"]
+    near = [
+        c
+        for c in survey_at(b, b.pickup, o.x, o.y)
+        if c.distance_to(o.x, o.y) < radius
+        and all(c.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)
+    ]
+    if not near:
+        b.log("the sherd seen at (%.3f, %.3f) m is not there now: surveying again" % (o.x, o.y))
+        return None
+    c = min(near, key=lambda c: c.distance_to(o.x, o.y))
+    if covered(c):
+        b.log("the sherd at (%.3f, %.3f) m is covered now: surveying again" % (c.x, c.y))
+        return None
+    return c

@@ -158,6 +158,7 @@ class Survey(BatchState):
             return self.run()
         b.empty_surveys = 0
         b.pending = in_pick_order(found, b.config["perception"]["selection_policy"])
+        b.pending_stale = False
         return "found"
 
 

@@ -1,0 +1,89 @@
+"""Core tests of PICKUP's rule that a grasp on the pickup mat uses a detection made after the
+mat last changed (`pickup.look_again`), run against the in-memory rig of `fake_rig.py`."""
+
+import math
+import os
+
+import pytest
+import yaml
+from fake_rig import GRASP_ABOVE, Recorder, Sherd, World
+
+from rascal_tasks import workflow
+from rascal_tasks.config import config_from_dict
+from rascal_tasks.survey import lawnmower
+
+WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+
+
+@pytest.fixture
+def config():
+    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
+        return config_from_dict(yaml.safe_load(f))
+
+
+def _run(config, world):
+    recorder = Recorder()
+    batch = workflow.Batch(config, world.rig(), recorder, context="T", log=print)
+    return workflow.build_machine(batch).execute(), batch, recorder
+
+
+def _when_holding(world, name, change):
+    """`change(world)` once, at the first move made while sherd `name` is in the fingers (what
+    the grasp did to the mat around it, or a person reaching in)."""
+    done = []
+
+    def refuse(x, y, z, yaw, linear):
+        if not done and world.held is not None and world.held.name == name:
+            done.append(True)
+            change(world)
+        return None
+
+    return refuse
+
+
+def _grasp_descents(config, world):
+    """(x, y) of every descent to grasp height on the pickup mat."""
+    grasp_z = config.stations["pickup"].surface_z + GRASP_ABOVE + 0.01  # a 10 mm tall sherd
+    return [(x, y) for x, y, z, _yaw, linear in world.moves if linear and z <= grasp_z + 1e-9]
+
+
+def test_a_sherd_nudged_since_the_survey_is_grasped_where_it_lies_now(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    b = world.sherds[1]
+    world.refuse = _when_holding(world, "a", lambda w: w.put(b, 0.265, 0.31))
+    outcome, _batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    descents = _grasp_descents(config, world)
+    assert not any(math.hypot(x - 0.25, y - 0.30) < 0.005 for x, y in descents), descents
+    assert rec.sherds[2].pickup_xy == pytest.approx((0.265, 0.31))
+
+
+def test_a_sherd_taken_away_since_the_survey_is_not_grasped_at(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    b = world.sherds[1]
+    world.refuse = _when_holding(world, "a", lambda w: w.put(b, 0.7, 0.7))  # off every station
+    outcome, _batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done"}
+    descents = _grasp_descents(config, world)
+    assert not any(math.hypot(x - 0.25, y - 0.30) < 0.05 for x, y in descents), descents
+
+
+def test_only_a_grasp_after_a_change_looks_again(config):
+    """The first grasp after a survey takes the survey's detection (nothing changed since);
+    the next one, after a grasp on the mat, looks once more first."""
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    _run(config, world)
+    pickup = config.stations["pickup"]
+    survey_z = pickup.surface_z + config["survey"]["z"]
+    views = len(lawnmower(pickup.area.center, pickup.area.size, config["survey"]["step"]))
+    looks = []  # wrist camera views of the mat before each grasp descent
+    n = 0
+    for x, y, z, _yaw, linear in world.moves:
+        if z == pytest.approx(survey_z) and pickup.area.has((x, y)):
+            n += 1
+        elif linear and z < survey_z and n:
+            looks.append(n)
+            n = 0
+    assert looks[:2] == [views, 1], looks
