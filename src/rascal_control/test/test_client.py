@@ -265,3 +265,33 @@ def test_gripper_goals_and_errors():
     failing = Gripper(client=FakeActionClient(GripperResultMsg(code=3, message="slow")))
     with pytest.raises(Timeout):
         failing.close()
+
+
+def test_open_while_sends_the_opening_before_the_move_and_waits_for_it_after():
+    events = []
+
+    class Ordered(FakeActionClient):
+        def send_goal(self, goal):
+            events.append("open sent")
+            super().send_goal(goal)
+
+        def wait_for_result(self, deadline, stop=None, budget=None):
+            events.append("open waited")
+            return super().wait_for_result(deadline, stop, budget)
+
+    gripper = Gripper(client=Ordered(GripperResultMsg(code=0, width=0.05)))
+    assert gripper.open_while(0.05, lambda: events.append("move") or "moved") == "moved"
+    assert events == ["open sent", "move", "open waited"]
+    assert gripper.width == 0.05
+
+    # a move that fails: its error is raised, after the opening was waited for
+    events.clear()
+    failing_open = Gripper(client=Ordered(GripperResultMsg(code=3, message="slow")))
+
+    def refused():
+        events.append("move")
+        raise Unreachable(1, "no IK")
+
+    with pytest.raises(Unreachable):
+        failing_open.open_while(0.05, refused)
+    assert events == ["open sent", "move", "open waited"]

@@ -9,8 +9,11 @@ import yaml
 from fake_rig import GRASP_ABOVE, Recorder, Sherd, World
 
 from rascal_tasks import workflow
-from rascal_tasks.config import config_from_dict
-from rascal_tasks.survey import lawnmower
+from rascal_tasks.config import config_from_dict, top_down_reachable
+from rascal_tasks.pickup import look_from
+from rascal_tasks.rig import Observation
+from rascal_tasks.survey import CAMERA_OFFSET, gripper_for_camera_over, lawnmower
+from rascal_tasks.wrist import route_yaw
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
@@ -87,3 +90,35 @@ def test_only_a_grasp_after_a_change_looks_again(config):
             looks.append(n)
             n = 0
     assert looks[:2] == [views, 1], looks
+
+
+def _seen_at(x, y, yaw=0.4):
+    return Observation(x, y, yaw, 0.05, 0.04, 0.01, x, y, 0.005, yaw, 0.052)
+
+
+@pytest.mark.parametrize("xy", [(0.08, 0.22), (0.16, 0.25), (0.24, 0.20), (0.05, 0.31)])
+def test_a_look_turns_the_gripper_as_its_grasp_will_be_with_the_camera_over_the_sherd(config, xy):
+    b = workflow.Batch(config, World(config, []).rig(), Recorder(), context="T")
+    b.last_pose = (*config.stations["discard"].place_at, 0.0)
+    o = _seen_at(*xy)
+    x, y, yaw = look_from(b, o)
+    assert (x, y) == xy
+    g = route_yaw(config, b.last_pose, xy, o.grasp_yaw, [p.station for p in b.plugins])
+    assert math.sin(yaw - g) == pytest.approx(0.0, abs=1e-9)  # the grasp's yaw, or turned by pi
+    ex, ey, _ = gripper_for_camera_over(x, y, yaw)
+    assert ex + CAMERA_OFFSET * math.cos(yaw) == pytest.approx(x)  # the camera over the sherd
+    assert top_down_reachable(ex, ey, config["survey"]["z"])
+
+
+def test_a_sherd_out_of_reach_at_the_survey_height_is_looked_at_from_the_survey_view(config):
+    b = workflow.Batch(config, World(config, []).rig(), Recorder(), context="T")
+    b.last_pose = (*config.stations["discard"].place_at, 0.0)
+    far = (0.30, 0.32)  # the mat's far corner
+    for yaw in (None, 0.0, math.pi / 2, math.pi, -math.pi / 2):
+        assert not top_down_reachable(*gripper_for_camera_over(*far, yaw)[:2], 0.25)
+    x, y, yaw = look_from(b, _seen_at(*far))
+    area = config.stations["pickup"].area
+    views = lawnmower(area.center, area.size, config["survey"]["step"])
+    assert (x, y) in views and yaw is None
+    assert math.hypot(x - far[0], y - far[1]) < 0.11  # within the camera's view of ~0.3 x 0.23 m
+    assert top_down_reachable(*gripper_for_camera_over(x, y)[:2], config["survey"]["z"])

@@ -57,7 +57,7 @@ class Gripper:
     @property
     def width(self) -> Optional[float]:
         """[m] opening at the end of the last command (None before the first)."""
-        return self.last_result.width if self.last_result else None
+        return self.last_result.width if self.last_result is not None else None
 
     def open(self, width: Optional[float] = None, timeout: Optional[float] = None) -> GripperResult:
         """Open fully, or to `width` [m]."""
@@ -75,11 +75,35 @@ class Gripper:
             )
         return self._run(2, width, timeout)
 
+    def open_while(self, width: Optional[float], during, timeout: Optional[float] = None):
+        """Open fully, or to `width` [m], while `during()` runs (an arm move the fingers' stroke
+        may overlap: the caller knows it is safe); returns what `during()` returned, once the
+        gripper has opened too. Should `during()` raise, the opening is still waited for (its
+        own failure then left to the next command) and `during()`'s error raised."""
+        self._send(0, width or 0.0)
+        try:
+            value = during()
+        except BaseException:
+            try:
+                self._wait(timeout)
+            except Exception:  # the move's failure is the one to report
+                pass
+            raise
+        self._wait(timeout)
+        return value
+
     def _run(self, command: int, width: float, timeout: Optional[float]) -> GripperResult:
+        self._send(command, width)
+        return self._wait(timeout)
+
+    def _send(self, command: int, width: float) -> None:
         from rascal_msgs.msg import GripperGoal
 
-        goal = GripperGoal(command=command, width=float(width))
-        self._client.send_goal(goal)
+        self._client.send_goal(GripperGoal(command=command, width=float(width)))
+
+    def _wait(self, timeout: Optional[float]) -> GripperResult:
+        """The result of the goal sent last; the deadline counts from now (a goal sent before
+        an arm move has had that move's time as well)."""
         deadline = dl.Deadline(
             timeout if timeout is not None else self.timings.gripper(), self._ros_now
         )

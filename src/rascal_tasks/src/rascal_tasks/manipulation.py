@@ -37,13 +37,17 @@ def _aiming_at(o: Observation, station):
 
 
 def grasp(b, o: Observation, station) -> bool:
-    """Open to the planned width (it includes the grasp margin), descend, close, lift.
+    """Open to the planned width (it includes the grasp margin) on the way to the approach pose,
+    descend, close, lift.
     Raises SherdFailure when the arm refuses the approach or the descent (failures.py)."""
-    with b.phase("grasping"):
-        b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
     approach = o.grasp_z + b.config["arm"]["approach_offset"]
     with _aiming_at(o, station):
-        b.move_down(o.grasp_x, o.grasp_y, approach, o.grasp_yaw)
+        # the fingers open on the way to the approach pose (its stroke is done long before the
+        # arm is low; the controller's collision check takes them fully open anyway)
+        b.rig.gripper.open_while(
+            opening_for(o.grasp_width, 0.0),
+            lambda: b.move_down(o.grasp_x, o.grasp_y, approach, o.grasp_yaw),
+        )
         b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)
     with b.phase("grasping"):
         held = b.rig.gripper.close().holding

@@ -2,15 +2,18 @@
 gripper, numbered. No ROS in here.
 """
 
-from typing import Optional
+import math
+from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
+from rascal_tasks.config import top_down_reachable
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
 from rascal_tasks.selection import covered, same_size
-from rascal_tasks.survey import SAME_SHERD, survey_at
+from rascal_tasks.survey import SAME_SHERD, gripper_for_camera_over, lawnmower, survey_at
+from rascal_tasks.wrist import route_yaw
 
 
 class Pickup(BatchState):
@@ -97,13 +100,14 @@ class Pickup(BatchState):
 
 
 def look_again(b, o: Observation) -> Optional[Observation]:
-    """The wrist camera over `o`, seen by an earlier survey: the detection nearest it now
-    (within recovery.search_radius: a neighbour's grasp may have nudged it), or None when
-    nothing pickable lies there any more (it was moved away, or now lies under another)."""
+    """The wrist camera over `o`, seen by an earlier survey (`look_from`): the detection
+    nearest it now (within recovery.search_radius: a neighbour's grasp may have nudged it), or
+    None when nothing pickable lies there any more (it was moved away, or now lies under
+    another)."""
     radius = b.config["recovery"]["search_radius"]
     near = [
         c
-        for c in survey_at(b, b.pickup, o.x, o.y)
+        for c in survey_at(b, b.pickup, *look_from(b, o))
         if c.distance_to(o.x, o.y) < radius
         and all(c.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)
     ]
@@ -115,3 +119,23 @@ def look_again(b, o: Observation) -> Optional[Observation]:
         b.log("the sherd at (%.3f, %.3f) m is covered now: surveying again" % (c.x, c.y))
         return None
     return c
+
+
+def look_from(b, o: Observation) -> Tuple[float, float, Optional[float]]:
+    """Where the wrist camera looks at `o` from, (x, y, gripper yaw or None: facing away from
+    the base), the first the arm reaches at the survey height (config.top_down_reachable):
+    over it, the gripper turned as its grasp will be along the sherd's way (wrist.route_yaw;
+    the fingers are alike turned by pi), so the move down to the grasp turns no wrist; over it,
+    facing away from the base; else the survey's view nearest it, which saw it before (the far
+    corners of the mat are out of reach at the survey height)."""
+    z = b.pickup.surface_z + b.config["survey"]["z"]
+    route = [p.station for p in b.plugins]
+    g = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
+    for yaw in (g, math.remainder(g + math.pi, 2.0 * math.pi), None):
+        ex, ey, _ = gripper_for_camera_over(o.x, o.y, yaw)
+        if top_down_reachable(ex, ey, z):
+            return o.x, o.y, yaw
+    area = b.pickup.area
+    views = lawnmower(area.center, area.size, b.config["survey"]["step"])
+    x, y = min(views, key=lambda v: o.distance_to(*v))
+    return x, y, None

@@ -146,6 +146,12 @@ class Gripper:
         """Open to `width` metres between the fingertips (None: fully); returns seconds."""
         raise NotImplementedError
 
+    def open_while(self, width: Optional[float], during):
+        """Open to `width` while `during()` runs (an arm move the caller knows the stroke may
+        overlap); returns `during()`'s value once both are done. Here: one after the other."""
+        self.open(width)
+        return during()
+
     def close(self) -> GraspResult:
         raise NotImplementedError
 

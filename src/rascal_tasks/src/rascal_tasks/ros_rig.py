@@ -280,6 +280,10 @@ class RosGripper(rig.Gripper):
     def open(self, width=None):
         return self._run(self._gripper.open, width).duration
 
+    def open_while(self, width, during):
+        # the controller runs gripper and arm goals side by side; a move's own RigError passes
+        return self._run(self._gripper.open_while, width, during)
+
     def close(self):
         res = self._run(self._gripper.close)
         return rig.GraspResult(bool(res.holding), res.width)

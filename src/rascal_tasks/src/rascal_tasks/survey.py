@@ -39,22 +39,25 @@ def lawnmower(
     return poses
 
 
-def gripper_for_camera_over(x: float, y: float) -> Tuple[float, float, float]:
+def gripper_for_camera_over(x: float, y: float, yaw=None) -> Tuple[float, float, float]:
     """(x, y, yaw) of ee_gripper_link, pointing down, that puts the wrist camera over (x, y):
-    the camera faces away from the base, so the gripper stays clear of what it looks at."""
-    yaw = math.atan2(y, x)
+    the camera faces away from the base, so the gripper stays clear of what it looks at
+    (`yaw` [rad]: the gripper turned so instead, the camera still over (x, y))."""
+    if yaw is None:
+        yaw = math.atan2(y, x)
     return x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw), yaw
 
 
-def camera_over(b, station, x, y):
+def camera_over(b, station, x, y, yaw=None):
     """Put the wrist camera over (x, y) of a station, at the survey height."""
-    ex, ey, yaw = gripper_for_camera_over(x, y)
+    ex, ey, yaw = gripper_for_camera_over(x, y, yaw)
     b.move_down(ex, ey, station.surface_z + b.config["survey"]["z"], yaw)
 
 
-def survey_at(b, station, x, y) -> List[Observation]:
-    """Put the wrist camera over (x, y) of a station and detect what is there."""
-    camera_over(b, station, x, y)
+def survey_at(b, station, x, y, yaw=None) -> List[Observation]:
+    """Put the wrist camera over (x, y) of a station (`yaw`: gripper_for_camera_over) and
+    detect what is there."""
+    camera_over(b, station, x, y, yaw)
     with b.phase("perception"):
         b.rig.clock.sleep(b.config["survey"]["settle_time"])
         return b.rig.perception.detect(station.name)
