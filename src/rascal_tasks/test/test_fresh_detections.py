@@ -3,6 +3,7 @@ mat last changed (`pickup.look_again`), run against the in-memory rig of `fake_r
 
 import math
 import os
+from dataclasses import replace
 
 import pytest
 import yaml
@@ -10,7 +11,7 @@ from fake_rig import GRASP_ABOVE, Recorder, Sherd, World
 
 from rascal_tasks import workflow
 from rascal_tasks.config import config_from_dict, top_down_reachable
-from rascal_tasks.pickup import look_from
+from rascal_tasks.pickup import both_views_diameter, look_from
 from rascal_tasks.rig import Observation
 from rascal_tasks.survey import CAMERA_OFFSET, gripper_for_camera_over, lawnmower
 from rascal_tasks.wrist import route_yaw
@@ -122,3 +123,22 @@ def test_a_sherd_out_of_reach_at_the_survey_height_is_looked_at_from_the_survey_
     assert (x, y) in views and yaw is None
     assert math.hypot(x - far[0], y - far[1]) < 0.11  # within the camera's view of ~0.3 x 0.23 m
     assert top_down_reachable(*gripper_for_camera_over(x, y)[:2], config["survey"]["z"])
+
+
+def test_the_vessel_diameter_of_two_views_is_their_inverse_variance_mean():
+    def seen(diameter, sigma):
+        return replace(_seen_at(0.1, 0.2), vessel_diameter=diameter, vessel_diameter_sigma=sigma)
+
+    # alike sigmas in curvature: the mean curvature; the sigma shrinks by about sqrt(2)
+    both = both_views_diameter(seen(0.400, 0.020), seen(0.400, 0.020))
+    assert both["vessel_diameter"] == pytest.approx(0.400)
+    assert both["vessel_diameter_sigma"] == pytest.approx(0.020 / math.sqrt(2))
+    both = both_views_diameter(seen(0.360, 0.013), seen(0.440, 0.013 * (0.44 / 0.36) ** 2))
+    assert both["vessel_diameter"] == pytest.approx(2.0 / ((2 / 0.36 + 2 / 0.44) / 2))
+    # the surer view counts more
+    surer = both_views_diameter(seen(0.360, 0.050), seen(0.440, 0.010))["vessel_diameter"]
+    assert 0.42 < surer < 0.44
+    # a view that told none: the other's
+    assert both_views_diameter(seen(0.0, 0.0), seen(0.44, 0.01))["vessel_diameter"] == 0.44
+    assert both_views_diameter(seen(0.44, 0.01), seen(0.0, 0.0))["vessel_diameter"] == 0.44
+    assert both_views_diameter(seen(0.0, 0.0), seen(0.0, 0.0))["vessel_diameter"] == 0.0

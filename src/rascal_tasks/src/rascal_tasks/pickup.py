@@ -2,6 +2,7 @@
 gripper, numbered. No ROS in here.
 """
 
+import dataclasses
 import math
 from typing import Optional, Tuple
 
@@ -118,7 +119,30 @@ def look_again(b, o: Observation) -> Optional[Observation]:
     if covered(c):
         b.log("the sherd at (%.3f, %.3f) m is covered now: surveying again" % (c.x, c.y))
         return None
+    if c.distance_to(o.x, o.y) <= SAME_SHERD and same_size(c, o):
+        return dataclasses.replace(c, **both_views_diameter(o, c))
     return c
+
+
+def both_views_diameter(a: Observation, b: Observation) -> dict:
+    """The vessel diameter of one sherd seen from two views, as Observation fields: the
+    inverse-variance mean of the two curvatures (2 / diameter), or the one view that told it.
+    One frame's curvature fit scatters by its sigma (bench/perception: within 15 % of the
+    truth for 96.6 % of those told); two independent views narrow it."""
+    told = [o for o in (a, b) if o.vessel_diameter > 0.0 and o.vessel_diameter_sigma > 0.0]
+    if len(told) < 2:
+        best = told[0] if told else b
+        return {
+            "vessel_diameter": best.vessel_diameter,
+            "vessel_diameter_sigma": best.vessel_diameter_sigma,
+        }
+    # curvature k = 2 / D, its sigma 2 sigma_D / D^2
+    k = [2.0 / o.vessel_diameter for o in told]
+    w = [(o.vessel_diameter**2 / (2.0 * o.vessel_diameter_sigma)) ** 2 for o in told]
+    mean = (k[0] * w[0] + k[1] * w[1]) / (w[0] + w[1])
+    sigma_k = (w[0] + w[1]) ** -0.5
+    diameter = 2.0 / mean
+    return {"vessel_diameter": diameter, "vessel_diameter_sigma": diameter**2 * sigma_k / 2.0}
 
 
 def look_from(b, o: Observation) -> Tuple[float, float, Optional[float]]:
