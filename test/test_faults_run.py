@@ -498,6 +498,11 @@ def test_random_node_killed_mid_batch_then_rerun_records_each_sherd_once(rig_fac
                 _restart(rig, victim)
         reruns = 0
         while code not in (0, 1):
+            if reruns and "its last batch finished complete" in out:
+                # `rascal` was killed after its batch was recorded finished, before it exited
+                # (CI at c393eb1: killed at 13.9 s): the rerun rightly refuses that context
+                code = 0
+                break
             reruns += 1
             assert reruns <= 3, note + "\n" + out[-3000:] + rig.tail()
             try:
