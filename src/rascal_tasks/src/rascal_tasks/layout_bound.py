@@ -25,7 +25,7 @@ from typing import Callable, Dict, List, Tuple
 
 from rascal_tasks.config import Config
 from rascal_tasks.joint_motion import move_time
-from rascal_tasks.survey import CAMERA_OFFSET, lawnmower
+from rascal_tasks.survey import gripper_for_camera_over, lawnmower
 
 # rascal_sim ScaleSensor (timing.md): first-order settling, readings every 0.1 s
 SCALE_TIME_CONSTANT = 0.3  # [s]
@@ -104,8 +104,7 @@ def camera_over_steps(cfg: Config, spots, what: str) -> List[Step]:
     st, sv = cfg.stations["pickup"], cfg["survey"]
     out = []
     for x, y in spots:
-        yaw = math.atan2(y, x)
-        ex, ey = x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw)
+        ex, ey, _ = gripper_for_camera_over(x, y)
         out.append(Step(what, (ex, ey, st.surface_z + sv["z"]), wait=sv["settle_time"]))
     return out
 
