@@ -16,6 +16,7 @@ from typing import Dict, List, Optional
 
 from rascal_tasks import rig
 from rascal_tasks.catalogue.errors import StatusError
+from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING
 from rascal_tasks.sorting import SherdValues, choose_bin
 from rascal_tasks.singulation import FINGERTIP
 from rascal_tasks.survey import CAMERA_OFFSET
@@ -41,6 +42,13 @@ class Sherd:
     # sweep of the fingers through it below its top lays it flat, unless it is `wedged`
     standing: bool = False
     wedged: bool = False
+    # the fingers close on it this wide (a chord across longer than its width seen from above:
+    # a grasp turned to clear neighbours); None: its width
+    held_width: Optional[float] = None
+
+    @property
+    def chord(self) -> float:
+        return self.width if self.held_width is None else self.held_width
 
 
 class World:
@@ -72,6 +80,7 @@ class World:
         # set down together on the mat, the two stay one on the other (else they fall apart)
         self.stay_stacked = False
         self.held_extra: Optional[Sherd] = None
+        self.opening: Optional[float] = None  # where the last open sent the fingers (None: closed)
 
     def station_at(self, x, y):
         for st in self.config.stations.values():
@@ -143,6 +152,10 @@ class _Gripper(rig.Gripper):
         self.w = world
 
     def open(self, width=None):
+        target = MAX_OPENING if width is None else width
+        if self.w.held is not None and target < self.w.held.chord:
+            return 0.5  # sent narrower than it is held: the fingers press on, let go of nothing
+        self.w.opening = target
         if self.w.held is not None:
             s, self.w.held = self.w.held, None
             x, y = self.w.at[:2]
@@ -161,6 +174,7 @@ class _Gripper(rig.Gripper):
         return 0.5
 
     def close(self):
+        self.w.opening = None
         x, y, z, _ = self.w.at
         st = self.w.station_at(x, y)
         lying = self.w.lying(st.name if st else None)
@@ -170,8 +184,8 @@ class _Gripper(rig.Gripper):
                 partner = self.w.doubles.pop(s.name, None)
                 if partner is not None:
                     self.w.held_extra = next(p for p in self.w.sherds if p.name == partner)
-                return rig.GraspResult(True, s.width)
-        return rig.GraspResult(False, 0.030)
+                return rig.GraspResult(True, s.chord)
+        return rig.GraspResult(False, MIN_OPENING)
 
     def holding(self):
         s = self.w.held
@@ -193,7 +207,9 @@ class _Gripper(rig.Gripper):
         return self.w.held is not None
 
     def width(self):
-        return self.w.held.width if self.w.held else 0.030
+        if self.w.held is not None:
+            return self.w.held.chord
+        return MIN_OPENING if self.w.opening is None else self.w.opening
 
 
 class _Perception(rig.Perception):

@@ -143,14 +143,22 @@ class _Arm(rig.Arm):
 
 
 class _Gripper(rig.Gripper):
+    def __init__(self):
+        self.opening = 0.04
+
     def open(self, width=None):
+        self.opening = 0.074 if width is None else width
         return 0.0
 
     def close(self):
+        self.opening = 0.04
         return rig.GraspResult(True, 0.04)
 
     def holding(self):
         return True
+
+    def width(self):
+        return self.opening
 
 
 class _Perception(rig.Perception):

@@ -14,10 +14,40 @@ from rascal_tasks.wrist import route_yaw
 
 # Opening between the fingertips, from the URDF's finger limits (facts §1.4: 30..74 mm).
 MIN_OPENING, MAX_OPENING = urdf_model.opening_limits()
+# [m] fingers this much short of the opening they were sent to stopped on something: the
+# controller calls a finger within 0.5 mm of its target there (GripperMonitor::kFingerReached)
+RELEASE_SLACK = 0.002
 
 
 def opening_for(width: float, margin: float) -> float:
     return min(MAX_OPENING, max(MIN_OPENING, width + margin))
+
+
+def release(b, width: float) -> float:
+    """Let go of what the fingers hold: open to `width` (the sherd's, seen from above) plus the
+    grasp margin, and never less than the margin wider than the fingers hold it now. A grasp
+    across a longer chord than the width seen (turned to clear neighbours, or a sherd partly
+    hidden in a heap) holds it wider, and an open narrower than that presses the fingers
+    inwards and lets nothing go. Checked: fingers that stopped short open fully; if they stop
+    short again, RigError (the sherd is not where the batch would record it). Returns the
+    opening the fingers held it at."""
+    margin = b.config["arm"]["grasp_margin"]
+    held = b.rig.gripper.width()
+    target = opening_for(max(width, held), margin)
+    b.rig.gripper.open(target)
+    if b.rig.gripper.width() >= target - RELEASE_SLACK:
+        return held
+    b.rig.gripper.open()
+    got = b.rig.gripper.width()
+    if got < MAX_OPENING - RELEASE_SLACK:
+        raise RigError(
+            "gripper",
+            "NOT_RELEASED",
+            "the fingers stopped at %.1f mm opening fully to let go of the sherd (sent to "
+            "%.1f mm): something holds them; free the fingers, then re-run"
+            % (got * 1000, MAX_OPENING * 1000),
+        )
+    return held
 
 
 @contextlib.contextmanager

@@ -23,7 +23,7 @@ class SherdRecord:
         self.observation: Optional[Observation] = None  # its detection (for its likeness)
         self.grasp_yaw = 0.0
         self.grasp_height = 0.0  # ee height above the surface when closing
-        self.width = 0.0  # across the fingers (m)
+        self.width = 0.0  # across the fingers (m): seen from above, or as they last held it
         self.station_index = -1  # last station done (-1: none yet)
         self.where = "pickup"  # station it was last seen at
         self.last_xy: Tuple[float, float] = (0.0, 0.0)

@@ -5,7 +5,7 @@ takes two sherds lifted as one back to the pickup mat, apart. No ROS here.
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
-from rascal_tasks.manipulation import grasp, opening_for
+from rascal_tasks.manipulation import grasp, opening_for, release
 from rascal_tasks.rig import Observation
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
@@ -57,7 +57,8 @@ class Place(BatchState):
             z = st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
             b.move_down(*st.place_at, z, yaw, linear=True)
         with b.phase("grasping"):
-            b.rig.gripper.open(opening_for(s.width, b.config["arm"]["grasp_margin"]))
+            # picked up again as wide as the fingers held it (a chord longer than its width)
+            s.width = max(s.width, release(b, s.width))
         if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)
             hover = st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
             b.move_down(*st.place_at, hover, yaw, linear=True)
@@ -238,7 +239,7 @@ class PutBack(BatchState):
         low = b.pickup.surface_z + height + b.config["arm"]["place_clearance"]
         b.move_down(x, y, low, yaw, linear=True)
         with b.phase("grasping"):
-            b.rig.gripper.open(opening_for(width, b.config["arm"]["grasp_margin"]))
+            release(b, width)
         b.move_down(x, y, b.travel_z(), yaw, linear=True)
 
 
