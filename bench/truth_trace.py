@@ -2,7 +2,8 @@
 """Where every simulated sherd is, over a batch: polls the simulator's ground truth (SIMULATOR
 ONLY, as the benches may) and appends one JSON line per poll in which a sherd moved more than
 2 mm or was taken or let go: {"t": simulated s, "w": POSIX s, "moved": {name: [x, y, z,
-held]}}. Run by
+held]}}; the first line says what each sherd is: {"sherds": {name: [g, length mm, width mm,
+wall mm]}}. Run by
 bench/heap beside a batch, so every row can be told which sherd it weighed; stopped by SIGTERM.
 
     /usr/bin/python3 bench/truth_trace.py OUT.jsonl
@@ -32,6 +33,12 @@ def main(path):
             except rospy.ServiceException:
                 time.sleep(PERIOD_S)
                 continue
+            if not last:
+                sizes = {
+                    s.name: [s.mass * 1e3, s.length * 1e3, s.width * 1e3, s.thickness * 1e3]
+                    for s in sherds
+                }
+                out.write(json.dumps({"sherds": sizes}) + "\n")
             moved = {}
             for s in sherds:
                 p = s.pose.position

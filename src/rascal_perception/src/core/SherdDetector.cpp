@@ -286,7 +286,9 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
   const double ppm = pixelsPerMetre(view, surface_z);
   stack.min_area_px = static_cast<int>(0.5 * std::pow(config_.min_sherd_size * ppm, 2));
   // something seen whole but not offered: where it lies and why, for the task layer to say
-  auto leave = [&](const Blob& b, const std::string& why) {
+  // `measured`: the measurer's outline and height where it got that far (its width, from the
+  // depth, is the strip's own; the image box of a standing sherd also holds a side face)
+  auto leave = [&](const Blob& b, const std::string& why, const SherdDetection* measured = nullptr) {
     Leftover l;
     l.why = why;
     l.length = std::max(b.box.size.width, b.box.size.height) / ppm;
@@ -301,8 +303,9 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
       l.yaw = wrapHalfPi(std::atan2(end.y() - l.position.y(), end.x() - l.position.x()));
     }
     l.height = topHeight(b, height);
+    const bool strip = measured && measured->width > 0.0 && measured->height > measured->width;
     // a sherd on its edge is as tall as a pickable sherd is wide; a thick chip is not
-    l.on_edge = l.height > l.width && l.height >= config_.min_sherd_size;
+    l.on_edge = (l.height > l.width || strip) && l.height >= config_.min_sherd_size;
     if (l.on_edge && l.why.find("edge") == std::string::npos) l.why += "; taller than wide: standing on its edge?";
     r.leftovers.push_back(std::move(l));
   };
@@ -327,7 +330,7 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
       std::string why;
       if (!measurer_.measure(part.blob, rgb, depth_mm, view, r.plane, d, why)) {
         ++r.rejected_size;
-        if (!depth_mm.empty()) leave(part.blob, why);
+        if (!depth_mm.empty()) leave(part.blob, why, &d);
         continue;
       }
       d.covered = part.covered;
