@@ -81,6 +81,7 @@ class World:
         self.stay_stacked = False
         self.held_extra: Optional[Sherd] = None
         self.opening: Optional[float] = None  # where the last open sent the fingers (None: closed)
+        self.bad_holds: Dict[str, int] = {}  # sherd name -> grasps on it that close on nothing
 
     def station_at(self, x, y):
         for st in self.config.stations.values():
@@ -180,6 +181,9 @@ class _Gripper(rig.Gripper):
         lying = self.w.lying(st.name if st else None)
         for s in sorted(lying, key=lambda s: -s.support):  # the top one of a stack
             if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.support + s.height:
+                if self.w.bad_holds.get(s.name, 0) > 0:
+                    self.w.bad_holds[s.name] -= 1
+                    break
                 self.w.held, self.w.grasped_at = s, (x, y)
                 partner = self.w.doubles.pop(s.name, None)
                 if partner is not None:

@@ -115,6 +115,29 @@ def test_an_unreachable_sherd_is_lost_and_the_next_one_is_recorded(config):
     assert batch.unpickable == [(0.13, 0.22)]
 
 
+def test_a_sherd_dropped_back_on_the_mat_and_not_grasped_there_gives_its_number_on(config):
+    """a slips on its way to the scale back onto the mat, where the recovery's grasps on it
+    close on nothing: it is not lost (it lies among the bag's sherds), its number goes to the
+    next sherd picked, and every sherd is recorded once, with no row lost."""
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.slips["a"] = (0.13, 0.22)
+    attempts = config["recovery"]["max_grasp_attempts"]
+
+    def once_held(x, y, z, yaw, linear):
+        if world.held is world.sherds[0] and "a" not in world.bad_holds:
+            world.bad_holds["a"] = attempts
+        return None
+
+    world.refuse = once_held
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert world.bad_holds == {"a": 0}  # the recovery did try it, every time
+    assert batch.lost == 0
+    assert {s.station for s in world.sherds} == {"discard"}
+    assert any("goes to the next sherd picked" in n for n in rec.sherds[1].notes)
+
+
 def test_an_unreachable_sherd_in_the_pickup_area_is_left_unnumbered(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
     world.refuse = _near(0.10, 0.22, below=config["arm"]["travel_z"])

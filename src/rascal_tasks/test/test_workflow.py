@@ -370,13 +370,28 @@ def test_a_found_sherd_that_slips_from_the_first_grasp_is_grasped_again(data):
     assert Recover(batch).run() == "held"
 
 
-def test_a_found_sherd_that_cannot_be_grasped_is_lost_after_the_attempts(data):
+def test_an_unmeasured_sherd_found_on_the_mat_that_cannot_be_grasped_gives_its_number_on(data):
+    """Not lost: it lies among the bag's sherds again, and a later pick records it (a lost row
+    for it as well would be a sherd counted twice)."""
     batch = _dropped_on_the_way(data, {"pickup": [_obs(0.21, 0.25, 0.054, 0.041)]})
+    s = batch.sherd
     tries = []
     batch.rig.gripper.close = lambda: tries.append(1) or rig.GraspResult(False, 0.03)
-    assert Recover(batch).run() == "lost"
+    assert Recover(batch).run() == "returned"
     assert len(tries) == data["recovery"]["max_grasp_attempts"]
+    assert not any(c[0] == "lost" for c in batch.recorder.calls)
+    assert batch.renumber is s and batch.sherd is None and batch.pending == []
+    notes = [c[2] for c in batch.recorder.calls if c[0] == "note"]
+    assert any("goes to the next sherd picked" in n for n in notes)
+
+
+def test_a_weighed_sherd_found_at_its_station_that_cannot_be_grasped_is_lost(data):
+    batch = _dropped_on_the_way(data, {"scale": [_obs(0.30, 0.0, 0.054, 0.041)]})
+    batch.sherd.station_index = 0
+    batch.rig.gripper.close = lambda: rig.GraspResult(False, 0.03)
+    assert Recover(batch).run() == "lost"
     assert any(c[0] == "lost" and "could not be picked up" in c[2] for c in batch.recorder.calls)
+    assert batch.renumber is None
 
 
 def test_a_weighed_sherd_is_never_replaced_by_one_from_the_pickup_area(data):

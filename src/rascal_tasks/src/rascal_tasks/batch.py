@@ -59,9 +59,9 @@ class Batch:
         self.pending_stale = False  # a grasp on the pickup mat since `pending` was surveyed
         self.put_back: Optional[tuple] = None  # (seq, x, y): a sherd Home took out of the fingers
         self.put_back_doubles = {}  # seq -> times its grasp was put back as two sherds in one
-        self.renumber: Optional[SherdRecord] = (
-            None  # put back as two: its number goes to the next pick
-        )
+        # an unmeasured sherd back among the bag's on the mat: its number goes to the next pick
+        self.renumber: Optional[SherdRecord] = None
+        self.renumber_unused = ""  # why that row is recorded lost if the mat empties first
         self.seen: List[Observation] = []  # the last survey of the pickup area, merged
         # what the last survey saw on the mat but perception did not offer (rig.Leftover)
         self.leftovers: List = []
@@ -105,6 +105,14 @@ class Batch:
         with self.phase("locomotion"):
             self.rig.arm.move_down(x, y, z, yaw, linear=linear)
         self.last_pose = (x, y, yaw)
+
+    def number_to_next_pick(self, s: "SherdRecord", unused: str):
+        """The sherd in progress, not measured, lies among the bag's sherds on the pickup mat
+        again: its row's number goes to the next sherd picked there (no gap, no row of two, no
+        row lost for a sherd recorded later); `unused`: why that row is recorded lost if the mat
+        empties first (survey.Survey)."""
+        self.renumber, self.renumber_unused = s, unused
+        self.sherd, self.pending = None, []
 
     def travel_z(self) -> float:
         return self.config["arm"]["travel_z"]

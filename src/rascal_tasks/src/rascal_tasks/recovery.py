@@ -22,12 +22,14 @@ class Recover(BatchState):
     drops it back there), or, if it was already measured, at the station it was carried to (it
     was never above the pickup area again, and a sherd from there would put another sherd's
     mass or photo in its row). Of what is found, the one most like it (position, then size) is
-    taken, so another sherd lying near is not; what lies off a station is left for a person."""
+    taken, so another sherd lying near is not; what lies off a station is left for a person.
+    One found on the pickup mat before it was measured that the grasps fail on is not lost: it
+    lies among the bag's sherds, and its number goes to the next sherd picked ('returned')."""
 
     next_sherd = "lost"
 
     def __init__(self, batch):
-        super().__init__(batch, ["held", "lost"])
+        super().__init__(batch, ["held", "lost", "returned"])
 
     def run(self):
         b = self.batch
@@ -47,7 +49,19 @@ class Recover(BatchState):
 
         o, tries, held = grasp_retrying(b, min(candidates, key=unlike), station, like=unlike)
         if not held:
-            return self.lose("found but could not be picked up (%d grasps)" % tries)
+            why = "found but could not be picked up (%d grasps)" % tries
+            if station is b.pickup and s.station_index < 0:
+                text = (
+                    "dropped back onto the pickup mat, %s there; this number goes to the next "
+                    "sherd picked" % why
+                )
+                b.event(s, "returned_to_mat", text)
+                s.note(text)
+                b.number_to_next_pick(
+                    s, "dropped back onto the pickup mat, %s, not picked " "again" % why
+                )
+                return "returned"
+            return self.lose(why)
         b.event(
             s, "recovered", "picked up again at the %s, (%.3f, %.3f) m" % (station.name, o.x, o.y)
         )

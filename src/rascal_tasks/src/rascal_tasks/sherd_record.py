@@ -47,8 +47,10 @@ class SherdRecord:
         return rec
 
     def taken_over(self, o: Observation, station):
-        """Its number goes to the sherd just picked as `o` (this one was two sherds, put back
-        apart: station_states.PutBack); where it was picked and its size are recorded afresh."""
+        """Its number goes to the sherd just picked as `o` (this one, not measured, lies among the
+        bag's sherds again: two put back apart, station_states.PutBack, or one dropped back onto
+        the mat that the recovery could not grasp); where it was picked and its size are
+        recorded afresh."""
         self.seen(o, station)
         self.picked_xy = (o.x, o.y)
         self.batch.recorder.taken_over(self.seq, (o.x, o.y))

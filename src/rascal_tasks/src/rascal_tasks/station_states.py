@@ -206,7 +206,7 @@ class PutBack(BatchState):
         )
         b.event(s, "put_back", text)
         s.note(text)
-        b.renumber, b.sherd, b.pending = s, None, []
+        b.number_to_next_pick(s, "put back on the pickup mat as two sherds and not seen again")
         return "surveyed"
 
     def _spot_beside(self, first):

@@ -154,7 +154,7 @@ class Survey(BatchState):
             if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
                 if b.renumber is not None:  # its number must not stay unfinished
                     b.sherd, b.renumber = b.renumber, None
-                    b.sherd.lose("put back on the pickup mat as two sherds and not seen again")
+                    b.sherd.lose(b.renumber_unused)
                 for lo in b.leftovers:
                     b.event(None, "not_taken", describe_leftover(lo))
                 return "empty"

@@ -96,7 +96,13 @@ def build_machine(batch: Batch):
                     held="TRANSLATE_%d" % (i + 1),
                     lost="SURVEY_NEXT",
                 )
-            add("RECOVER_%d" % i, Recover(batch), held="TRANSLATE_%d" % i, lost="SURVEY_NEXT")
+            add(
+                "RECOVER_%d" % i,
+                Recover(batch),
+                held="TRANSLATE_%d" % i,
+                lost="SURVEY_NEXT",
+                returned="SURVEY",
+            )
         add("SURVEY_NEXT", NextSherd(batch), pickup="PICKUP", survey="SURVEY")
         add("PARK", Park(batch), done="finished", aborted="aborted", preempted="preempted")
         add(
