@@ -14,13 +14,17 @@ import os
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
-from rascal_tasks import rig
+import yaml
+
+from rascal_tasks import rig, workflow
+from rascal_tasks.config import config_from_dict
 from rascal_tasks.catalogue.errors import StatusError
 from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING
 from rascal_tasks.sorting import SherdValues, choose_bin
 from rascal_tasks.singulation import FINGERTIP
 from rascal_tasks.survey import CAMERA_OFFSET
 
+WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 VIEW_RADIUS = 0.15  # m around the wrist camera's axis
 DOUBLE_APART = 0.05  # m between two sherds set down together on the pickup mat
 GRASP_ABOVE = 0.005  # grasp_z above the station surface that perception plans
@@ -438,3 +442,16 @@ class Recorder:
 
     def status(self) -> Dict[int, str]:
         return {seq: row.status for seq, row in sorted(self.sherds.items())}
+
+
+def shipped_config():
+    """config/rascal.yaml of this workspace, loaded as `rascal run` loads it."""
+    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
+        return config_from_dict(yaml.safe_load(f))
+
+
+def run_batch(config, world: World, recorder: Optional[Recorder] = None):
+    """The whole batch machine against `world`: (outcome, batch, recorder)."""
+    recorder = recorder or Recorder()
+    batch = workflow.Batch(config, world.rig(), recorder, context="T", log=print)
+    return workflow.build_machine(batch).execute(), batch, recorder

@@ -2,33 +2,26 @@
 mat last changed (`pickup.look_again`), run against the in-memory rig of `fake_rig.py`."""
 
 import math
-import os
 from dataclasses import replace
 
 import pytest
-import yaml
-from fake_rig import GRASP_ABOVE, Recorder, Sherd, World
+from fake_rig import GRASP_ABOVE, Recorder, Sherd, World, run_batch, shipped_config
 
 from rascal_tasks import workflow
-from rascal_tasks.config import config_from_dict, top_down_reachable
+from rascal_tasks.config import top_down_reachable
 from rascal_tasks.pickup import both_views_diameter, look_from
 from rascal_tasks.rig import Observation
 from rascal_tasks.survey import CAMERA_OFFSET, gripper_for_camera_over, lawnmower
 from rascal_tasks.wrist import route_yaw
 
-WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
-
 
 @pytest.fixture
 def config():
-    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
-        return config_from_dict(yaml.safe_load(f))
+    return shipped_config()
 
 
 def _run(config, world):
-    recorder = Recorder()
-    batch = workflow.Batch(config, world.rig(), recorder, context="T", log=print)
-    return workflow.build_machine(batch).execute(), batch, recorder
+    return run_batch(config, world)
 
 
 def _when_holding(world, name, change):

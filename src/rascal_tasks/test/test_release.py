@@ -3,30 +3,18 @@ they hold it, and that they got there is checked. Against the in-memory rig of `
 whose gripper, like a position-commanded one, presses on when sent narrower than it holds.
 """
 
-import os
 from types import SimpleNamespace
 
 import pytest
-import yaml
-from fake_rig import Recorder, Sherd, World
+from fake_rig import Sherd, World, run_batch, shipped_config
 
-from rascal_tasks import rig, workflow
-from rascal_tasks.config import config_from_dict
+from rascal_tasks import rig
 from rascal_tasks.manipulation import MAX_OPENING, release
-
-WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
 
 @pytest.fixture
 def config():
-    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
-        return config_from_dict(yaml.safe_load(f))
-
-
-def _run(config, world):
-    recorder = Recorder()
-    batch = workflow.Batch(config, world.rig(), recorder, context="T", log=print)
-    return workflow.build_machine(batch).execute(), batch, recorder
+    return shipped_config()
 
 
 def test_a_sherd_held_wider_than_seen_is_let_go_at_every_station(config):
@@ -35,7 +23,7 @@ def test_a_sherd_held_wider_than_seen_is_let_go_at_every_station(config):
     would ride along, unweighed, unphotographed, to be let go wherever the fingers next open."""
     a = Sherd("a", 0.12, 0.24, width=0.035, held_width=0.055, mass=0.027)
     world = World(config, [a, Sherd("b", 0.25, 0.30, mass=0.019)])
-    outcome, _batch, rec = _run(config, world)
+    outcome, _batch, rec = run_batch(config, world)
     assert outcome == "finished"
     assert rec.status() == {1: "done", 2: "done"}
     assert rec.sherds[1].mass == pytest.approx(0.027)
