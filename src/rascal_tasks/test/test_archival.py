@@ -56,11 +56,20 @@ def _sherd_polygon(centre, length_px, width_px, angle_deg):
 
 
 def synthetic(
-    seed, chip="5YR 6/6", gains=(1.0, 1.0, 1.0), brightness=1.0, noise=2.0, bar=True, chart_in=True
+    seed,
+    chip="5YR 6/6",
+    gains=(1.0, 1.0, 1.0),
+    brightness=1.0,
+    noise=2.0,
+    bar=True,
+    chart_in=True,
+    body_srgb=None,
+    band_srgb=None,
 ):
     """A photo: table, chart and bar at random places, angles and scales, one octagonal
     sherd; lit by per-channel `gains` (a colour cast) times `brightness`, with noise.
-    Returns (rgb8, truth)."""
+    `body_srgb`: the sherd's colour instead of `chip`'s; `band_srgb`: a painted band along it, a
+    quarter of its width wide. Returns (rgb8, truth)."""
     rng = np.random.default_rng(seed)
     px_per_mm = rng.uniform(4.0, 5.0)
     img = np.empty((H, W, 3), np.uint8)
@@ -83,8 +92,22 @@ def synthetic(
     poly = _sherd_polygon(
         np.array(cells[order[2]], float), L * px_per_mm, Wd * px_per_mm, rng.uniform(0, 180)
     )
+    if body_srgb is not None:
+        srgb = body_srgb
     cv2.fillPoly(img, [poly], tuple(int(v) for v in srgb))
-    truth.update(length_mm=L, width_mm=Wd, chip=chip)
+    if band_srgb is not None:
+        band = np.zeros(img.shape[:2], np.uint8)
+        cv2.line(
+            band,
+            tuple(int(v) for v in poly[0]),
+            tuple(int(v) for v in poly[4]),
+            255,
+            max(1, int(Wd * px_per_mm / 4)),
+        )
+        inside = np.zeros_like(band)
+        cv2.fillPoly(inside, [poly], 255)
+        img[(band > 0) & (inside > 0)] = band_srgb
+    truth.update(length_mm=L, width_mm=Wd, chip=chip, centre_px=cells[order[2]])
     lin = col.decode(img) * np.asarray(gains) * brightness
     out = col.encode(lin).astype(np.float64) + rng.normal(0, noise, img.shape)
     return np.clip(np.round(out), 0, 255).astype(np.uint8), truth
@@ -169,6 +192,34 @@ def test_wrist_disagreement_is_flagged():
     assert any(f.startswith("size disagrees") for f in r.flags)
     r = analyse_rgb(rgb, wrist_size_mm=(truth["length_mm"] + 0.5, truth["width_mm"]))
     assert not any(f.startswith("size disagrees") for f in r.flags)
+
+
+@pytest.mark.parametrize("seed", [41, 42, 43])
+def test_a_painted_sherd_whose_body_is_near_the_tables_colour_is_measured_whole(seed):
+    """Its body 3 L*a*b* units darker than the table (the whole photo's threshold misses it),
+    under a pale painted band that alone stands out: the wrist camera's size says the band is
+    far too small, so the sherd is looked for again against the table around the band, and
+    measured whole (heap runs photographed such sherds as 47 x 14 mm bands)."""
+    rgb, truth = synthetic(seed, body_srgb=(132, 121, 102), band_srgb=(215, 195, 150))
+    assert analyse_rgb(rgb).width_mm < truth["width_mm"] / 2  # the band alone, unasked
+    r = analyse_rgb(rgb, wrist_size_mm=(truth["length_mm"] + 0.5, truth["width_mm"] - 0.5))
+    assert r.length_mm == pytest.approx(truth["length_mm"], abs=1.5), r.flags
+    assert r.width_mm == pytest.approx(truth["width_mm"], abs=1.5), r.flags
+    assert not any(f.startswith("size disagrees") for f in r.flags), r.flags
+
+
+@pytest.mark.parametrize("seed", [41, 44])
+def test_a_plain_sherd_near_the_tables_colour_is_said_not_found_or_found_where_it_was_put(seed):
+    """Nothing of it stands out from the whole photo: not found, and said so; told where it
+    was put (`hint_px`), it is looked for against the table around there and measured whole."""
+    rgb, truth = synthetic(seed, body_srgb=(132, 121, 102))
+    wrist = (truth["length_mm"] + 0.5, truth["width_mm"] - 0.5)
+    r = analyse_rgb(rgb, wrist_size_mm=wrist)
+    assert r.length_mm is None and "sherd not found in the archival photo" in r.flags
+    put = np.asarray(truth["centre_px"], float) + (12.0, -9.0)  # placed a few mm off
+    r = analyse_rgb(rgb, wrist_size_mm=wrist, hint_px=tuple(put))
+    assert r.length_mm == pytest.approx(truth["length_mm"], abs=1.5), r.flags
+    assert r.width_mm == pytest.approx(truth["width_mm"], abs=1.5), r.flags
 
 
 def test_blank_image_gives_flags_not_exceptions(tmp_path):

@@ -22,6 +22,10 @@ MAX_CHART_DE00 = 3.0  # mean CIEDE2000 of the chart above this: the colour is fl
 MAX_CHIP_DE00 = 6.0  # the nearest soil-chart chip farther than this: flagged (glaze, paint)
 MAX_REPROJECTION_PX = 2.0  # a chart or bar fit worse than this is flagged
 SHADOW_LIGHTNESS_WEIGHT = 0.3  # second segmentation: lightness differences count this much
+# a region under this share of the area the wrist camera's size expects is looked for again as a
+# faint sherd (size.find_faint_sherd) around it, within the sherd's length and this much play
+FAINT_AREA = 0.5
+PLACE_PLAY_MM = 10.0
 SIZE_TOLERANCE_MM = 2.0  # archival and wrist length/width may differ by this ...
 SIZE_TOLERANCE_FRAC = 0.05  # ... or this share of the length, whichever is larger
 BAR_CHART_AGREEMENT = 0.04  # bar and chart scales may differ by this share (chart: 1 px edges)
@@ -108,6 +112,23 @@ def analyse_rgb(
         # a region far larger than the sherd: a shadow across the table joined it? Again,
         # with lightness counting less than colour
         other = sz.find_sherd(seg, exclude, hint_px, lightness_weight=SHADOW_LIGHTNESS_WEIGHT)
+        if other is not None and (
+            sherd is None
+            or abs(np.log(other.area_px / expected)) < abs(np.log(sherd.area_px / expected))
+        ):
+            sherd = other
+    near = hint_px if hint_px is not None else _centre(sherd.mask) if sherd is not None else None
+    if (
+        expected is not None
+        and near is not None
+        and (sherd is None or sherd.area_px < FAINT_AREA * expected)
+    ):
+        # a region far smaller than the sherd: one near the table's colour, of which only an
+        # edge or a painted band stood out? Again, against the table around that region (or
+        # where it was put), within the sherd's length and the placing's play
+        px_per_mm = r.px_per_cm / 10.0
+        radius = (max(wrist_size_mm) + PLACE_PLAY_MM) * px_per_mm
+        other = sz.find_faint_sherd(seg, exclude, near, radius)
         if other is not None and (
             sherd is None
             or abs(np.log(other.area_px / expected)) < abs(np.log(sherd.area_px / expected))
@@ -233,6 +254,11 @@ def locate_bar(rgb, feats, geometry: Geometry, chart, r: ArchivalResult):
 
 def _scale(loc, geometry):
     return ch.bar_px_per_cm(loc, geometry.bar)
+
+
+def _centre(mask: np.ndarray) -> Tuple[float, float]:
+    m = cv2.moments(mask, binaryImage=True)
+    return m["m10"] / m["m00"], m["m01"] / m["m00"]
 
 
 def analyse(path: str, **kwargs) -> ArchivalResult:

@@ -20,6 +20,11 @@ MIN_SHERD_PX = 800  # a region smaller than this is not a sherd
 MIN_COLOUR_PX = 300  # fewer pixels left for the colour: too small to tell
 HIGHLIGHT_PCT = 95.0  # brighter pixels than this percentile are highlights
 SHADOW_PCT = 10.0  # darker pixels than this percentile are shadows
+# a faint sherd (find_faint_sherd): farther from the table around it than this many times the
+# table's own median distance there (the ring may cross the chart or the bar), and than this
+# many L*a*b* units
+FAINT_SPREADS = 4.0
+MIN_FAINT_DISTANCE = 2.0
 
 
 @dataclass
@@ -73,6 +78,62 @@ def find_sherd(
     contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     c = max(contours, key=cv2.contourArea)
     mask = np.zeros_like(region)
+    cv2.drawContours(mask, [c], -1, 255, thickness=cv2.FILLED)  # holes (paint, glare) filled
+    return region_of(mask)
+
+
+def find_faint_sherd(
+    rgb8: np.ndarray,
+    exclude: Optional[np.ndarray],
+    hint_px: Tuple[float, float],
+    radius_px: float,
+) -> Optional[SherdRegion]:
+    """A sherd close to the table's colour (or whose body is, under a bright paint that alone
+    stood out), expected within `radius_px` of `hint_px`: the table's colour and its spread
+    (median distance) from a ring just outside that circle (the light falls off towards the
+    photo's corners, so the whole photo's median is not the table here), and every pixel
+    inside farther from it than FAINT_SPREADS times that spread (and MIN_FAINT_DISTANCE).
+    None if nothing stands out."""
+    h, w = rgb8.shape[:2]
+    r_out = 1.5 * radius_px
+    x0, x1 = int(max(0, hint_px[0] - r_out)), int(min(w, hint_px[0] + r_out + 1))
+    y0, y1 = int(max(0, hint_px[1] - r_out)), int(min(h, hint_px[1] + r_out + 1))
+    if x1 - x0 < 8 or y1 - y0 < 8:
+        return None
+    lab = cv2.GaussianBlur(_lab(rgb8[y0:y1, x0:x1]), (0, 0), 2.0)
+    keep = np.ones(lab.shape[:2], bool) if exclude is None else exclude[y0:y1, x0:x1] == 0
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    r = np.hypot(xx - hint_px[0], yy - hint_px[1])
+    ring = keep & (r >= 1.2 * radius_px) & (r <= r_out)
+    if ring.sum() < 100:
+        return None
+    table = np.median(lab[ring], axis=0)
+    dist = np.sqrt(np.sum((lab - table) ** 2, axis=2))
+    cut = max(MIN_FAINT_DISTANCE, FAINT_SPREADS * float(np.median(dist[ring])))
+    cand = ((dist > cut) & keep & (r < 1.2 * radius_px)).astype(np.uint8) * 255
+    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
+    cand = cv2.morphologyEx(cand, cv2.MORPH_OPEN, k)
+    # where a paint paler than the table meets a body darker than it, the smoothed colour
+    # passes through the table's: a seam a few pixels wide, closed here
+    seam = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (11, 11))
+    cand = cv2.morphologyEx(cand, cv2.MORPH_CLOSE, seam)
+    hint = (hint_px[0] - x0, hint_px[1] - y0)
+    best = _pick(cand, hint)
+    if best is None:
+        return None
+    # its edge from the barely smoothed photo: smoothing spreads a bright paint's edge outwards
+    raw = cv2.GaussianBlur(_lab(rgb8[y0:y1, x0:x1]), (3, 3), 0)
+    edge = np.sqrt(np.sum((raw - table) ** 2, axis=2))
+    near = cv2.dilate(best, k, iterations=3) > 0
+    refined = ((edge > cut) & near & keep).astype(np.uint8) * 255
+    refined = cv2.morphologyEx(refined, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+    refined = cv2.morphologyEx(refined, cv2.MORPH_CLOSE, seam)
+    best = _pick(refined, hint) if refined.any() else None
+    if best is None:
+        return None
+    contours, _ = cv2.findContours(best, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    mask = np.zeros((h, w), np.uint8)
+    c = max(contours, key=cv2.contourArea) + np.array([x0, y0])
     cv2.drawContours(mask, [c], -1, 255, thickness=cv2.FILLED)  # holes (paint, glare) filled
     return region_of(mask)
 
