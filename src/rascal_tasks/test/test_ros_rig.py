@@ -54,3 +54,38 @@ def test_scale_readings_keep_their_stamp_and_flag():
     assert (r.mass, r.stable, r.stamp) == (0.0139, True, pytest.approx(12.3))
     m.header.stamp.secs = m.header.stamp.nsecs = 0  # a driver that does not stamp
     assert RosScale.reading_from_msg(m, received=99.0).stamp == 99.0
+
+
+def test_a_transform_not_there_yet_is_waited_for_then_said_in_one_line():
+    """TF's publisher is another process: a pose asked for at an image's stamp may come a
+    little later (a loaded machine; CI once saw 0.28 s), so the lookup is tried again until
+    a wall-clock deadline, and only then said, in one line."""
+    from rascal_tasks.ros_session import SessionError, wait_for_transform
+
+    class LateTf:
+        calls = 0
+
+        def lookup_transform(self, target, frame, stamp):
+            self.calls += 1
+            if self.calls < 3:
+                raise RuntimeError("Lookup would require extrapolation into the future.\nmore")
+            return (target, frame, stamp)
+
+    tf = LateTf()
+    assert wait_for_transform(tf, "camera_color_optical_frame", 83.5) == (
+        "base_link",
+        "camera_color_optical_frame",
+        83.5,
+    )
+    assert tf.calls == 3
+
+    class NeverTf:
+        def lookup_transform(self, target, frame, stamp):
+            raise RuntimeError("Lookup would require extrapolation into the future.\nmore")
+
+    with pytest.raises(SessionError) as e:
+        wait_for_transform(NeverTf(), "camera_color_optical_frame", 83.5, wait=0.05)
+    assert str(e.value) == (
+        "TF base_link -> camera_color_optical_frame: Lookup would require extrapolation into "
+        "the future."
+    )

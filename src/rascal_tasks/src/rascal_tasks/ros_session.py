@@ -8,6 +8,7 @@ happened.
 import signal
 import sys
 import threading
+import time
 
 import rospy
 
@@ -18,7 +19,11 @@ from rascal_tasks.ros_graph import GraphError, Need, check_master, wait_for_node
 from rascal_tasks.run_lock import Busy, RigLock
 
 MASTER_TIMEOUT = 3.0  # [s]
-TF_WAIT = 1.0  # [s] for a frame's pose at a given stamp
+# [s] of wall time for a frame's pose at a given stamp: TF's publisher is another process, and a
+# loaded machine can leave it that far behind (a wait counted in simulated time can be over in
+# a few wall-clock milliseconds on a simulator running faster than real time)
+TF_WAIT = 2.0
+TF_POLL = 0.01  # [s]
 ARM = ("arm_controller", "start it with rosrun rascal_control arm_controller")
 ARM_NEEDS = [Need("action", "/rascal/arm/move", *ARM)]
 
@@ -29,6 +34,21 @@ class SessionError(Exception):
     def __init__(self, message: str, code: int):
         super().__init__(message)
         self.code = code
+
+
+def wait_for_transform(tf, frame: str, stamp, wait=TF_WAIT, clock=time.monotonic):
+    """`tf.lookup_transform("base_link", frame, stamp)`, tried every TF_POLL s until it answers
+    or `wait` seconds of `clock` have passed; then SessionError with tf2's reason."""
+    deadline = clock() + wait
+    while True:
+        try:
+            return tf.lookup_transform("base_link", frame, stamp)
+        except Exception as e:  # tf2's lookup, connectivity and extrapolation errors alike
+            if clock() >= deadline:
+                raise SessionError(
+                    "TF base_link -> %s: %s" % (frame, str(e).splitlines()[0]), exit_codes.FAULT
+                ) from None
+        time.sleep(TF_POLL)
 
 
 def rotation(q):
@@ -115,15 +135,9 @@ class ArmSession:
             print("error: the arm could not be parked: %s" % e, file=sys.stderr)
 
     def transform(self, frame: str, stamp=None):
-        """`frame`'s pose in base_link (geometry_msgs TransformStamped) at `stamp` (latest)."""
-        try:
-            return self.tf.lookup_transform(
-                "base_link", frame, stamp or rospy.Time(0), rospy.Duration(TF_WAIT)
-            )
-        except Exception as e:  # tf2's lookup, connectivity and extrapolation errors alike
-            raise SessionError(
-                "TF base_link -> %s: %s" % (frame, str(e).splitlines()[0]), exit_codes.FAULT
-            ) from None
+        """`frame`'s pose in base_link (geometry_msgs TransformStamped) at `stamp` (latest),
+        waited for up to TF_WAIT seconds of wall time."""
+        return wait_for_transform(self.tf, frame, stamp or rospy.Time(0))
 
     def gripper_pose(self):
         """(x, y, z, yaw) of ee_gripper_link now (the gripper pointing down)."""
