@@ -131,6 +131,23 @@ def test_call_returns_raises_or_gives_up():
     release.set()
 
 
+def test_a_background_call_runs_while_the_caller_works_and_says_when_it_failed():
+    go = threading.Event()
+    pending = dl.Background(lambda: go.wait(5.0) and "photo")
+    assert not pending.finished.is_set() and not pending.failed()  # the caller works meanwhile
+    go.set()
+    assert pending.result(dl.Deadline(1.0, time.monotonic)) == "photo"
+
+    def refused():
+        raise RuntimeError("arm in view")
+
+    failing = dl.Background(refused)
+    failing.finished.wait(1.0)
+    assert failing.failed()
+    with pytest.raises(RuntimeError):
+        failing.result(dl.Deadline(1.0, time.monotonic))
+
+
 def test_controller_timings_from_the_config_and_the_schema():
     cfg = {
         "arm": {"settle_timeout": 1.5, "state_timeout": 0.5, "gripper": {"timeout": 2.0}},

@@ -109,6 +109,29 @@ def test_a_dslr_shot_a_stop_darker_gets_half_the_shutter_time(tmp_path):
     assert len(os.listdir(tmp_path / "card")) == 4  # the JPEGs left on the card
 
 
+def test_a_dslr_says_its_shutter_closed_before_the_download_and_not_when_it_failed(tmp_path):
+    gp, camera = _dslr(tmp_path)
+    camera.open()
+    said = []
+    download = camera.camera.file_get
+
+    def file_get(*args):  # the image leaves the camera only after the word
+        said.append("download")
+        return download(*args)
+
+    camera.camera.file_get = file_get
+    camera.capture(str(tmp_path / "a.png"), 0.0, lambda: said.append("exposed"))
+    assert said == ["exposed", "download"]
+
+    def refuses(path, exposure_ev):
+        raise RuntimeError("arm in view")
+
+    gp.shoot = refuses
+    with pytest.raises(CaptureError):
+        camera.capture(str(tmp_path / "b.png"), 0.0, lambda: said.append("exposed"))
+    assert said == ["exposed", "download"]
+
+
 def test_dslr_faults_are_one_line_and_leave_no_file(tmp_path):
     def refuses(path, exposure_ev):
         raise RuntimeError("arm in view")

@@ -72,6 +72,9 @@ class World:
         self.lift_slips: Dict[str, Optional[tuple]] = {}
         self.camera_refusals = 0  # captures to refuse before one succeeds
         self.camera_refuses = lambda exposure_ev: False  # and any capture this says
+        self.transfer_failures = 0  # captures to fail after their shutter, in the transfer
+        self.at_shutter: List[tuple] = []  # where the gripper (x, y, z, yaw) was at each shutter
+        self.transfer_moves: List[list] = []  # the moves made during each capture's transfer
         # photos written (into `photo_folder`) when set: a grey frame with a white patch of
         # `photo_light` x 255 x 2^EV (clipped at 255), of 1 % of the frame; the EVs asked for
         self.photo_folder: Optional[str] = None
@@ -301,13 +304,27 @@ class _Scale(rig.Scale):
 
 
 class _Camera(rig.ArchivalCamera):
+    """Refuses before its shutter (`camera_refusals`, `camera_refuses`) or after it, in the
+    transfer (`transfer_failures`); `at_shutter` keeps where the gripper was at each shutter,
+    `transfer_moves` the arm's moves during each transfer."""
+
     def __init__(self, world):
         self.w = world
 
-    def capture(self, path, exposure_ev=0.0):
+    def capture_while(self, path, exposure_ev, during):
         if self.w.camera_refusals > 0 or self.w.camera_refuses(exposure_ev):
             self.w.camera_refusals = max(0, self.w.camera_refusals - 1)
             raise rig.RigError("/archival_camera/capture", "REFUSED", "cannot write " + path)
+        self.w.at_shutter.append(self.w.at)
+        moved = len(self.w.moves)
+        during()  # the transfer: the arm may move
+        self.w.transfer_moves.append(self.w.moves[moved:])
+        if self.w.transfer_failures > 0:
+            self.w.transfer_failures -= 1
+            raise rig.RigError("/archival_camera/capture", "REFUSED", "cannot write " + path)
+        return self.capture(path, exposure_ev)
+
+    def capture(self, path, exposure_ev=0.0):
         self.w.exposures.append(exposure_ev)
         if self.w.photo_folder is None:
             return rig.Capture(path, self.w.t, 2000, 1500)

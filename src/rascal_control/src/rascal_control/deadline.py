@@ -155,24 +155,39 @@ def wait_for(
         sleep(SLICE)
 
 
+class Background:
+    """fn(*args) (a blocking service call) running in a worker thread from construction on, so
+    the caller can do other work meanwhile (`Gripper.open_while`'s pattern for service calls)."""
+
+    def __init__(self, fn: Callable, *args):
+        self._box = {}
+        self.finished = threading.Event()
+        threading.Thread(target=self._work, args=(fn, args), daemon=True).start()
+
+    def _work(self, fn, args):
+        try:
+            self._box["value"] = fn(*args)
+        except BaseException as e:  # handed to the caller
+            self._box["error"] = e
+        finally:
+            self.finished.set()
+
+    def failed(self) -> bool:
+        """Finished, with an exception."""
+        return self.finished.is_set() and "error" in self._box
+
+    def result(self, deadline: Deadline, stop: Optional[threading.Event] = None):
+        """Its value or its exception once it finishes, or Unfinished(STOPPED or EXPIRED) when
+        the wait ends first (the worker is left to finish)."""
+        outcome = wait_for(self.finished.is_set, deadline, stop, sleep=self.finished.wait)
+        if outcome != DONE:
+            raise Unfinished(outcome)
+        if "error" in self._box:
+            raise self._box["error"]
+        return self._box["value"]
+
+
 def call(fn: Callable, *args, deadline: Deadline, stop: Optional[threading.Event] = None):
     """fn(*args) (a blocking service call) in a worker thread: its value or its exception, or
     Unfinished(STOPPED or EXPIRED) when the wait ends first (the worker is left to finish)."""
-    box = {}
-    finished = threading.Event()
-
-    def work():
-        try:
-            box["value"] = fn(*args)
-        except BaseException as e:  # handed to the caller
-            box["error"] = e
-        finally:
-            finished.set()
-
-    threading.Thread(target=work, daemon=True).start()
-    outcome = wait_for(finished.is_set, deadline, stop, sleep=finished.wait)
-    if outcome != DONE:
-        raise Unfinished(outcome)
-    if "error" in box:
-        raise box["error"]
-    return box["value"]
+    return Background(fn, *args).result(deadline, stop)

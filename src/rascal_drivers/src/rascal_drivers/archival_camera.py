@@ -82,9 +82,10 @@ class OpenCvCamera:
         self.capture_.set(self.cv2.CAP_PROP_EXPOSURE, seconds * 1e4)  # V4L2: 100 us units
         self.exposure_ev = exposure_ev
 
-    def capture(self, path: str, exposure_ev: float = 0.0) -> Tuple[int, int]:
+    def capture(self, path: str, exposure_ev: float = 0.0, exposed=None) -> Tuple[int, int]:
         """A still at `exposure_ev` stops from the configured exposure (a file or an image
-        sequence has no exposure: there it is the source's own)."""
+        sequence has no exposure: there it is the source's own); `exposed()` is called once
+        the frame is taken, before it is stored."""
         if self.v4l2 and exposure_ev != self.exposure_ev:
             self._set_exposure(exposure_ev)
         if self.v4l2:
@@ -93,6 +94,8 @@ class OpenCvCamera:
         ok, image = self.capture_.read()
         if not ok:
             raise CaptureError("no frame from %s; is the camera still connected?" % self.device)
+        if exposed is not None:
+            exposed()
         return store_png(self.cv2, image, path)
 
     def close(self) -> None:
@@ -175,13 +178,16 @@ class GphotoCamera:
         self.camera.set_config(config)
         self.exposure_ev = exposure_ev
 
-    def capture(self, path: str, exposure_ev: float = 0.0) -> Tuple[int, int]:
-        """A still at `exposure_ev` stops from the configured shutter time."""
+    def capture(self, path: str, exposure_ev: float = 0.0, exposed=None) -> Tuple[int, int]:
+        """A still at `exposure_ev` stops from the configured shutter time; `exposed()` is
+        called once the shutter has closed (the image is on the camera), before the download."""
         gp = self.gp
         if exposure_ev != self.exposure_ev:
             self._configure(exposure_ev)
         try:
             where = self.camera.capture(gp.GP_CAPTURE_IMAGE)
+            if exposed is not None:
+                exposed()
             camera_file = self.camera.file_get(where.folder, where.name, gp.GP_FILE_TYPE_NORMAL)
             fd, tmp = tempfile.mkstemp(suffix=os.path.splitext(where.name)[1])
             os.close(fd)

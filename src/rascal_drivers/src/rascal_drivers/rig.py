@@ -46,6 +46,7 @@ SIM_REMAPS = (
     "/scale/mass:=%s/scale/mass" % SIM_NS,
     "/scale/tare:=%s/scale/tare" % SIM_NS,
     "/archival_camera/capture:=%s/archival_camera/capture" % SIM_NS,
+    "/archival_camera/exposed:=%s/archival_camera/exposed" % SIM_NS,
     "/camera/color/image_raw:=%s/camera/color/image_raw" % SIM_NS,
     "/camera/color/camera_info:=%s/camera/color/camera_info" % SIM_NS,
     "/camera/aligned_depth_to_color/image_raw:=%s/camera/aligned_depth_to_color/image_raw" % SIM_NS,

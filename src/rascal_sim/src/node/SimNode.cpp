@@ -4,6 +4,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <rascal_msgs/ScaleReading.h>
 #include <sensor_msgs/JointState.h>
+#include <std_msgs/Header.h>
 
 #include <malloc.h>
 
@@ -57,6 +58,8 @@ SimNode::SimNode(ros::NodeHandle&) {
   colour_info_pub_ = root.advertise<sensor_msgs::CameraInfo>("/camera/color/camera_info", 2);
   depth_info_pub_ = root.advertise<sensor_msgs::CameraInfo>("/camera/aligned_depth_to_color/camera_info", 2);
   cloud_pub_ = root.advertise<sensor_msgs::PointCloud2>("/camera/depth/color/points", 2);
+  // the shutter has closed: the arm may come back over the sherd during the transfer
+  exposed_pub_ = root.advertise<std_msgs::Header>("/archival_camera/exposed", 4);
   arm_sub_ = root.subscribe("/arm/joint_trajectory", 10, &SimNode::onArmTrajectory, this);
   gripper_sub_ = root.subscribe("/gripper/command", 10, &SimNode::onGripperCommand, this);
   tare_srv_ = root.advertiseService("/scale/tare", &SimNode::onTare, this);
@@ -259,6 +262,10 @@ bool SimNode::onCapture(rascal_msgs::CaptureArchival::Request& req, rascal_msgs:
       cam.acknowledge();
       return true;
     }
+    std_msgs::Header exposed;
+    exposed.stamp = res.stamp;
+    exposed.frame_id = "archival_camera_optical_frame";
+    exposed_pub_.publish(exposed);
     const cv::Mat image = cam.image();
     const double ready = cam.readyTime();
     std::string path = req.path;

@@ -55,7 +55,7 @@ class SimNode {
   std::condition_variable stepped_;
 
   ros::Publisher clock_pub_, joint_pub_, scale_pub_, colour_pub_, depth_pub_, colour_info_pub_,
-      depth_info_pub_, cloud_pub_;
+      depth_info_pub_, cloud_pub_, exposed_pub_;
   ros::Subscriber arm_sub_, gripper_sub_;
   ros::ServiceServer tare_srv_, capture_srv_, truth_srv_, spawn_srv_, reset_srv_, fault_srv_;
   tf2_ros::StaticTransformBroadcaster static_tf_;

@@ -44,6 +44,7 @@ class Batch:
         self.sherd: Optional[SherdRecord] = None
         # Time spent for the sherd in progress (or the next one: surveying counts for it).
         self.timings = Timings(started=rig.clock.now())
+        self._phases: List[float] = []  # the phases running now, innermost last (phase())
         self.state_times = {}  # state label -> seconds, for the summary and the benchmark
         self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
         self.misses = {}  # rounded (x, y) -> pickups that failed there
@@ -80,11 +81,17 @@ class Batch:
 
     @contextlib.contextmanager
     def phase(self, name: str):
+        """Time spent in `name` (rig.Timings); a phase inside another (the arm moving during
+        a capture's transfer) counts as the inner one only, so the phases add up to the time."""
         t0 = self.rig.clock.now()
+        self._phases.append(0.0)  # seconds spent in phases nested inside this one
         try:
             yield
         finally:
-            self.timings.add(name, self.rig.clock.now() - t0)
+            spent = self.rig.clock.now() - t0
+            self.timings.add(name, spent - self._phases.pop())
+            if self._phases:
+                self._phases[-1] += spent
 
     def event(self, sherd: Optional[SherdRecord], kind: str, detail: str = ""):
         """Log what happened; a sherd's events also go into its catalogue notes."""

@@ -8,8 +8,9 @@ vectors from the arm's own IK, with the wrist turned the least (yaw along the ar
 grasp); the gripper's strokes only as wide as the grasp margin; the stations' own times from the
 simulator's models (the scale's settling, the camera's shutter and transfer). Two figures:
 
-- `serial`: that sequence with every wait in series, as the workflow runs it today (the whole
-  capture with the arm at standby; the tare is done while the arm is at the later stations,
+- `serial`: that sequence with the waits as the workflow runs them today (the shutter with
+  the arm at standby, the transfer overlapped only by the way back over the sherd,
+  `ArchivalCameraStation`; the tare is done while the arm is at the later stations,
   `ScaleStation.while_away`);
 - `bound`: the same moves with only what cannot overlap arm motion (the loaded scale settling
   while the arm hovers, the shutter): no planner margin, no transfer wait.
@@ -53,7 +54,8 @@ class Step:
     what: str
     pose: Tuple[float, float, float]  # x, y, z of ee_gripper_link [m]
     wait: float = 0.0  # [s] after arriving (gripper stroke, station) in the bound
-    serial_wait: float = 0.0  # [s] more, in series, as the workflow runs today
+    serial_wait: float = 0.0  # [s] more as the workflow runs today: in series, but for...
+    overlaps_next: bool = False  # ...the next move, made meanwhile
 
 
 def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> List[Step]:
@@ -92,8 +94,16 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
             steps.append(Step("lift", (x, y, travel)))
             if st.type == "archival_camera":
                 sx, sy = arm["standby"]
-                steps.append(Step("standby", (sx, sy, travel), wait=SHUTTER, serial_wait=TRANSFER))
-                steps.append(Step("over " + name, (x, y, travel)))
+                steps.append(
+                    Step(
+                        "standby",
+                        (sx, sy, travel),
+                        wait=SHUTTER,
+                        serial_wait=TRANSFER,
+                        overlaps_next=True,
+                    )
+                )
+                steps.append(Step("back over " + name, (x, y, z + approach)))
             steps.append(Step("descend", (x, y, z), wait=margin_stroke))
         steps.append(Step("lift", (x, y, travel)))
     return steps
@@ -118,13 +128,17 @@ def survey_steps(cfg: Config) -> List[Step]:
 def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, list]:
     """(motion, bound waits, serial waits, last joints) of `steps` from the joints `start`."""
     q, motion, waits, serial = start, 0.0, 0.0, 0.0
+    overlapping = 0.0  # a serial wait the next move is made during
     for s in steps:
         q1 = ik(*s.pose, q)
-        motion += move_time(q, q1)
+        move = move_time(q, q1)
+        motion += move
+        serial += max(0.0, overlapping - move)
         waits += s.wait
-        serial += s.serial_wait
+        overlapping = s.serial_wait if s.overlaps_next else 0.0
+        serial += 0.0 if s.overlaps_next else s.serial_wait
         q = q1
-    return motion, waits, serial, q
+    return motion, waits, serial + overlapping, q
 
 
 def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str, float]:

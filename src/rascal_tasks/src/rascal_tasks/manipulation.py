@@ -66,18 +66,43 @@ def _aiming_at(o: Observation, station):
         raise
 
 
+def approach(b, o: Observation) -> None:
+    """To the pose above `o` where a grasp's descent starts, the fingers opening to the planned
+    width (it includes the grasp margin) on the way: the stroke is done long before the arm
+    is low, and the controller's collision check takes them fully open anyway. Where the arm
+    is there already (it came back over a photographed sherd during the transfer), the move
+    and the opening cost only their answers."""
+    above = o.grasp_z + b.config["arm"]["approach_offset"]
+    b.rig.gripper.open_while(
+        opening_for(o.grasp_width, 0.0),
+        lambda: b.move_down(o.grasp_x, o.grasp_y, above, o.grasp_yaw),
+    )
+
+
+def placed_observation(b, s, station) -> Observation:
+    """Where the sherd in progress `s` was set down on `station`, as it was held: the blind
+    grasp that picks it up again (`station_states.repick`)."""
+    x, y = s.last_xy
+    return Observation(
+        x,
+        y,
+        s.grasp_yaw,
+        s.observation.length,
+        s.width,
+        0.0,
+        x,
+        y,
+        station.surface_z + s.grasp_height,
+        s.grasp_yaw,
+        opening_for(s.width, b.config["arm"]["grasp_margin"]),
+    )
+
+
 def grasp(b, o: Observation, station) -> bool:
-    """Open to the planned width (it includes the grasp margin) on the way to the approach pose,
-    descend, close, lift.
+    """Open on the way to the approach pose (`approach`), descend, close, lift.
     Raises SherdFailure when the arm refuses the approach or the descent (failures.py)."""
-    approach = o.grasp_z + b.config["arm"]["approach_offset"]
     with _aiming_at(o, station):
-        # the fingers open on the way to the approach pose (its stroke is done long before the
-        # arm is low; the controller's collision check takes them fully open anyway)
-        b.rig.gripper.open_while(
-            opening_for(o.grasp_width, 0.0),
-            lambda: b.move_down(o.grasp_x, o.grasp_y, approach, o.grasp_yaw),
-        )
+        approach(b, o)
         b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)
     with b.phase("grasping"):
         held = b.rig.gripper.close().holding

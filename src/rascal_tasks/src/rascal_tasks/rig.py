@@ -198,6 +198,15 @@ class ArchivalCamera:
         """One photo stored at `path`, `exposure_ev` stops from the configured exposure."""
         raise NotImplementedError
 
+    def capture_while(self, path: str, exposure_ev: float, during) -> Capture:
+        """`capture`, with `during()` (the arm's way back over the sherd) run once the shutter
+        has closed, while the image is still being transferred; returns the capture once both
+        are done. Raises the capture's RigError without running `during()` when it fails
+        before the shutter closed. Here: one after the other."""
+        capture = self.capture(path, exposure_ev)
+        during()
+        return capture
+
 
 class Clock:
     def now(self) -> float:

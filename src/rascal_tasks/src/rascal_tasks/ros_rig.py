@@ -18,6 +18,7 @@ from rascal_control import Arm as ControlArm
 from rascal_control import Gripper as ControlGripper
 from rascal_control import deadline as dl
 from rascal_control.results import ControlError, Timeout
+from std_msgs.msg import Header
 from std_srvs.srv import Trigger
 
 from rascal_msgs.msg import GripperState
@@ -39,6 +40,8 @@ CODE_NAMES = {
     6: "DRIVER_RESTARTED",
     7: "TRACKING_ERROR",
 }
+# the archival camera's shutter has closed (RosArchivalCamera)
+EXPOSED = "/archival_camera/exposed"
 TF_WAIT = 0.5  # [s] the detector's TF lookup after its frame (rascal_perception's README)
 CLOCK_STALL = 2.0  # [s] wall time without ROS time moving: the clock (simulator) is gone
 
@@ -128,15 +131,22 @@ def _config(config):
 def _call(fn, *args, seconds, stop, device, code, node, name):
     """A service call with a deadline of `seconds` (ROS and wall time) that `stop` interrupts;
     RigError(device, TIMEOUT | PREEMPTED | code) naming `node` and the service `name`."""
+    deadline = dl.Deadline(seconds, dl.ros_time)
+    return _answer(dl.Background(fn, *args), deadline, stop, device, code, node, name)
+
+
+def _answer(pending, deadline, stop, device, code, node, name):
+    """The answer of a service call running in the background (dl.Background), or _call's
+    RigError."""
     try:
-        return dl.call(fn, *args, deadline=dl.Deadline(seconds, dl.ros_time), stop=stop)
+        return pending.result(deadline, stop)
     except dl.Unfinished as e:
         if e.outcome == dl.STOPPED:
             raise rig.RigError(device, "PREEMPTED", "stop requested") from None
         raise rig.RigError(
             device,
             "TIMEOUT",
-            "%s not answering on %s within %.1f s; is it running?" % (node, name, seconds),
+            "%s not answering on %s within %.1f s; is it running?" % (node, name, deadline.seconds),
         ) from None
     except rospy.ServiceException as e:
         first = (str(e).splitlines() or [type(e).__name__])[0]
@@ -409,27 +419,59 @@ class RosScale(rig.Scale):
 
 
 class RosArchivalCamera(rig.ArchivalCamera):
-    """/archival_camera/capture, answered within rig.capture_timeout."""
+    """/archival_camera/capture, answered within rig.capture_timeout. The camera (the
+    simulator, or archival_camera_driver) says on /archival_camera/exposed (std_msgs/Header,
+    stamped with the capture's shutter time) when the shutter has closed: the arm may then
+    move over the sherd while the image is transferred (`capture_while`)."""
+
+    SERVICE = "/archival_camera/capture"
+    NODE = "the archival camera (its driver, or the simulator)"
 
     def __init__(self, config=None, stop=None):
         self.timeout = _config(config)["rig"]["capture_timeout"]
         self._stop = stop
-        self._capture = _proxy("/archival_camera/capture", CaptureArchival)
+        self._capture = _proxy(self.SERVICE, CaptureArchival)
+        self._exposed = threading.Event()
+        self._since = None
+        self._exposed_sub = rospy.Subscriber(EXPOSED, Header, self._on_exposed, queue_size=4)
+
+    def _on_exposed(self, msg):
+        since = self._since
+        if since is not None and msg.stamp.to_sec() >= since:
+            self._exposed.set()
 
     def capture(self, path, exposure_ev=0.0):
-        res = _call(
-            self._capture,
-            path,
-            exposure_ev,
-            seconds=self.timeout,
-            stop=self._stop,
-            device="/archival_camera/capture",
-            code="FAILED",
-            node="the archival camera (its driver, or the simulator)",
-            name="/archival_camera/capture",
-        )
+        return self.capture_while(path, exposure_ev, None)
+
+    def capture_while(self, path, exposure_ev, during):
+        deadline = dl.Deadline(self.timeout, dl.ros_time)
+        answer = (deadline, self._stop, self.SERVICE, "FAILED", self.NODE, self.SERVICE)
+        self._exposed.clear()
+        self._since = rospy.get_time()  # a shutter from before this call is not this one's
+        pending = dl.Background(self._capture, path, exposure_ev)
+        moved = during is None
+        if not moved:
+            # the arm stays out of view until the shutter has closed, or the capture ended
+            outcome = dl.wait_for(
+                lambda: self._exposed.is_set() or pending.finished.is_set(),
+                deadline,
+                self._stop,
+            )
+            if outcome == dl.DONE and not pending.failed():
+                moved = True
+                try:
+                    during()
+                except BaseException:
+                    try:  # a move's failure is the one to report; the capture still ends
+                        _answer(pending, *answer)
+                    except Exception:
+                        pass
+                    raise
+        res = _answer(pending, *answer)
         if not res.success:
-            raise rig.RigError("/archival_camera/capture", "REFUSED", res.message)
+            raise rig.RigError(self.SERVICE, "REFUSED", res.message)
+        if not moved:
+            during()  # the answer came before the word that the shutter closed
         return rig.Capture(res.path, res.stamp.to_sec(), res.width, res.height)
 
 

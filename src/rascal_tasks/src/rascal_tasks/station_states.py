@@ -5,7 +5,7 @@ takes two sherds lifted as one back to the pickup mat, apart. No ROS here.
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
-from rascal_tasks.manipulation import grasp, opening_for, release
+from rascal_tasks.manipulation import grasp, placed_observation, release
 from rascal_tasks.rig import Observation
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
@@ -133,19 +133,7 @@ def repick(b, index) -> bool:
     s = b.sherd
     st = b.config.stations[b.station_names[index]]
     x, y = s.last_xy
-    o = Observation(
-        x,
-        y,
-        s.grasp_yaw,
-        s.observation.length,
-        s.width,
-        0.0,
-        x,
-        y,
-        st.surface_z + s.grasp_height,
-        s.grasp_yaw,
-        opening_for(s.width, b.config["arm"]["grasp_margin"]),
-    )
+    o = placed_observation(b, s, st)
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
         if grasp(b, o, st):
             return True
