@@ -20,27 +20,25 @@ def _at_standby(at, standby, travel):
     return at[:2] == pytest.approx(standby) and at[2] == pytest.approx(travel)
 
 
-def test_the_shutter_sees_no_arm_and_the_arm_is_back_over_the_sherd_by_the_photo(config):
+def test_the_shutter_sees_no_arm_and_the_fingers_are_open_around_the_sherd_by_the_photo(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
     outcome, _batch, rec = run_batch(config, world)
     assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
     cam, standby, travel = _poses(config)
     assert len(world.at_shutter) == 2
     assert all(_at_standby(at, standby, travel) for at in world.at_shutter)
-    # the way back over the sherd is made while the image is transferred
-    assert [len(m) for m in world.transfer_moves] == [1, 1]
-    assert all(m[0][:2] == pytest.approx(tuple(cam.place_at)) for m in world.transfer_moves)
-    # after each shutter: over the sherd at the approach height, then straight down to it
-    # (the repick's approach is where the arm already is); never back to travel height between
-    approach = config["arm"]["approach_offset"]
-    for k, m in enumerate(world.moves):
-        if not (_at_standby(m, standby, travel) and k + 1 < len(world.moves)):
-            continue
-        over, *rest = world.moves[k + 1 :]
+    # while the image is transferred: over the sherd, then straight down to its grasp height
+    for moves in world.transfer_moves:
+        over, down = moves
         assert over[:2] == pytest.approx(tuple(cam.place_at)) and not over[4]
-        assert over[2] > cam.surface_z and over[2] < travel - approach / 2
-        down = next(r for r in rest if r[:3] != over[:3])
-        assert down[:2] == pytest.approx(over[:2]) and down[2] < over[2] and down[4]
+        assert down[:2] == pytest.approx(tuple(cam.place_at)) and down[4]
+        assert cam.surface_z < down[2] < over[2] < travel
+    # the next move after each transfer is the lift of the picked-up sherd: REPICK only closed
+    for k, m in enumerate(world.moves):
+        if _at_standby(m, standby, travel):
+            lift = world.moves[k + 3]
+            assert lift[:2] == pytest.approx(tuple(cam.place_at)) and lift[2] == travel
+            assert lift[4]
 
 
 def test_a_transfer_that_fails_is_shot_again_from_standby_after_lifting_straight_up(config):

@@ -9,7 +9,7 @@ import pytest
 from fake_rig import Sherd, World, run_batch, shipped_config
 
 from rascal_tasks import rig
-from rascal_tasks.manipulation import MAX_OPENING, release
+from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING, release
 
 
 @pytest.fixture
@@ -72,3 +72,6 @@ def test_fingers_sent_wider_than_they_held_it_report_that_width(config):
     b = SimpleNamespace(config=config, rig=SimpleNamespace(gripper=gripper))
     assert release(b, 0.030) == pytest.approx(0.045)  # the chord it was held across
     assert gripper.sent == [pytest.approx(0.057)]
+    # fingers that had closed on nothing (30 mm) say nothing of a 20 mm sherd's width
+    gripper.at = MIN_OPENING
+    assert release(b, 0.020) == pytest.approx(0.020)

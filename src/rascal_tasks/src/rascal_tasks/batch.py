@@ -49,6 +49,9 @@ class Batch:
         self.stop_requested = threading.Event()  # set on Ctrl-C: stop at the next rig call
         self.misses = {}  # rounded (x, y) -> pickups that failed there
         self.last_pose = None  # (x, y, yaw) of the last top-down move (wrist.route_yaw)
+        # the grasp (an Observation) the arm stands ready to close on, open around the sherd:
+        # a station brought it there while it waited (manipulation.grasp); any move clears it
+        self.poised: Optional[Observation] = None
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
         self.lift_slips: List[Observation] = []  # grasped sherds that slipped out while lifted
         self.unchecked_slips: List[Observation] = []  # ... not yet looked for by a survey
@@ -109,6 +112,7 @@ class Batch:
     def move_down(self, x, y, z, yaw, linear=False):
         self.check_stop()
         self.last_pose = None  # unknown until the arm got there
+        self.poised = None
         with self.phase("locomotion"):
             self.rig.arm.move_down(x, y, z, yaw, linear=linear)
         self.last_pose = (x, y, yaw)

@@ -30,13 +30,15 @@ def release(b, width: float) -> float:
     hidden in a heap) holds it wider, and an open narrower than that presses the fingers
     inwards and lets nothing go. Checked: fingers that stopped short open fully; if they stop
     short again, RigError (the sherd is not where the batch would record it). Returns the
-    opening the fingers held it at."""
+    width to pick it up by again: `width`, or the opening the fingers held it at when wider
+    (fingers that had closed on nothing say nothing of the sherd)."""
     margin = b.config["arm"]["grasp_margin"]
     held = b.rig.gripper.width()
     target = opening_for(max(width, held), margin)
+    again = max(width, held) if held > MIN_OPENING + RELEASE_SLACK else width
     b.rig.gripper.open(target)
     if b.rig.gripper.width() >= target - RELEASE_SLACK:
-        return held
+        return again
     b.rig.gripper.open()
     got = b.rig.gripper.width()
     if got < MAX_OPENING - RELEASE_SLACK:
@@ -47,7 +49,7 @@ def release(b, width: float) -> float:
             "%.1f mm): something holds them; free the fingers, then re-run"
             % (got * 1000, MAX_OPENING * 1000),
         )
-    return held
+    return again
 
 
 @contextlib.contextmanager
@@ -69,9 +71,7 @@ def _aiming_at(o: Observation, station):
 def approach(b, o: Observation) -> None:
     """To the pose above `o` where a grasp's descent starts, the fingers opening to the planned
     width (it includes the grasp margin) on the way: the stroke is done long before the arm
-    is low, and the controller's collision check takes them fully open anyway. Where the arm
-    is there already (it came back over a photographed sherd during the transfer), the move
-    and the opening cost only their answers."""
+    is low, and the controller's collision check takes them fully open anyway."""
     above = o.grasp_z + b.config["arm"]["approach_offset"]
     b.rig.gripper.open_while(
         opening_for(o.grasp_width, 0.0),
@@ -98,12 +98,22 @@ def placed_observation(b, s, station) -> Observation:
     )
 
 
+def reach(b, o: Observation) -> None:
+    """Open on the way to the approach pose (`approach`), descend: the fingers stand open
+    around the sherd, ready to close (`b.poised`)."""
+    approach(b, o)
+    b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)
+    b.poised = o
+
+
 def grasp(b, o: Observation, station) -> bool:
-    """Open on the way to the approach pose (`approach`), descend, close, lift.
+    """Reach for `o` (unless the arm is poised there already: a station brought it while it
+    waited), close, lift.
     Raises SherdFailure when the arm refuses the approach or the descent (failures.py)."""
-    with _aiming_at(o, station):
-        approach(b, o)
-        b.move_down(o.grasp_x, o.grasp_y, o.grasp_z, o.grasp_yaw, linear=True)
+    if b.poised != o:
+        with _aiming_at(o, station):
+            reach(b, o)
+    b.poised = None
     with b.phase("grasping"):
         held = b.rig.gripper.close().holding
     b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)

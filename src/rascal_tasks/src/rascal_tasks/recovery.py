@@ -58,7 +58,7 @@ class Recover(BatchState):
                 b.event(s, "returned_to_mat", text)
                 s.note(text)
                 b.number_to_next_pick(
-                    s, "dropped back onto the pickup mat, %s, not picked " "again" % why
+                    s, "dropped back onto the pickup mat, %s, not picked again" % why
                 )
                 return "returned"
             return self.lose(why)

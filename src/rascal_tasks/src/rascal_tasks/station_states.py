@@ -58,7 +58,7 @@ class Place(BatchState):
             b.move_down(*st.place_at, z, yaw, linear=True)
         with b.phase("grasping"):
             # picked up again as wide as the fingers held it (a chord longer than its width)
-            s.width = max(s.width, release(b, s.width))
+            s.width = release(b, s.width)
         if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)
             hover = st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
             b.move_down(*st.place_at, hover, yaw, linear=True)

@@ -70,13 +70,13 @@ class StationPlugin:
         station may start here, without waiting, what its next sherd needs (the scale tares its
         empty pan)."""
 
-    def back_over(self, sherd) -> None:
-        """The arm back over `sherd`, lying here, where its pick-up descends
-        (manipulation.approach): for a plug-in to run while it waits with the arm away."""
+    def reach_back(self, sherd) -> None:
+        """The arm back at `sherd`, lying here, the fingers open around it, ready to pick it up
+        (manipulation.reach): for a plug-in to run while it waits with the arm away."""
         # imported here: manipulation -> survey -> batch imports this module
-        from rascal_tasks.manipulation import approach, placed_observation
+        from rascal_tasks.manipulation import placed_observation, reach
 
-        approach(self.batch, placed_observation(self.batch, sherd, self.station))
+        reach(self.batch, placed_observation(self.batch, sherd, self.station))
 
     def after_place(self, sherd) -> str:
         """Called with the sherd placed and the gripper back at travel height; records what it
@@ -338,11 +338,11 @@ class ArchivalCameraStation(StationPlugin):
     def __init__(self, station, batch):
         super().__init__(station, batch)
         self.exposure = Exposure()
-        self.over_sherd = False  # the arm came back over the sherd during a capture
+        self.at_sherd = False  # the arm reached back for the sherd during a capture
 
     def after_place(self, sherd):
         b = self.batch
-        self.over_sherd = False  # placing lifted the arm to travel height
+        self.at_sherd = False  # placing lifted the arm to travel height
         with b.phase("data_collection"):
             capture = self._capture(sherd, sherd.spool_path())
             if capture is None:
@@ -367,16 +367,16 @@ class ArchivalCameraStation(StationPlugin):
         return "done"
 
     def _capture(self, sherd, path):
-        """The capture at the batch's exposure, taken with the arm at standby; the arm comes
-        back over the sherd, where its pick-up descends, once the shutter has closed, while
-        the image is transferred (rig.ArchivalCamera.capture_while). CAPTURE_ATTEMPTS tries;
-        None, with the arm at standby, when all failed."""
+        """The capture at the batch's exposure, taken with the arm at standby; once the shutter
+        has closed the arm reaches back for the sherd, its fingers open around it, while the
+        image is transferred (rig.ArchivalCamera.capture_while): REPICK only closes them.
+        CAPTURE_ATTEMPTS tries; None, with the arm at standby, when all failed."""
         b = self.batch
         for attempt in range(self.CAPTURE_ATTEMPTS):
             self._standby(sherd)
             try:
                 return b.rig.camera.capture_while(
-                    path, self.exposure.ev, lambda: self._back_over(sherd)
+                    path, self.exposure.ev, lambda: self._reach_back(sherd)
                 )
             except RigError as e:
                 b.event(sherd, "capture_failed", "attempt %d: %s" % (attempt + 1, e.reason))
@@ -384,18 +384,18 @@ class ArchivalCameraStation(StationPlugin):
         self._standby(sherd)
         return None
 
-    def _back_over(self, sherd):
-        self.over_sherd = True
-        self.back_over(sherd)
+    def _reach_back(self, sherd):
+        self.at_sherd = True
+        self.reach_back(sherd)
 
     def _standby(self, sherd):
         """Out of the camera's view, the wrist camera facing away too (the sherd was set down
-        turned so); from over the sherd (a retake, a failed transfer) straight up first."""
+        turned so); from the sherd (a retake, a failed transfer) straight up first."""
         b = self.batch
-        if self.over_sherd:
+        if self.at_sherd:
             x, y = sherd.last_xy
             b.move_down(x, y, b.travel_z(), sherd.grasp_yaw, linear=True)
-            self.over_sherd = False
+            self.at_sherd = False
         sx, sy = b.config["arm"]["standby"]
         b.move_down(sx, sy, b.travel_z(), standby_yaw(b.config, self.station))
 

@@ -112,11 +112,7 @@ def analyse_rgb(
         # a region far larger than the sherd: a shadow across the table joined it? Again,
         # with lightness counting less than colour
         other = sz.find_sherd(seg, exclude, hint_px, lightness_weight=SHADOW_LIGHTNESS_WEIGHT)
-        if other is not None and (
-            sherd is None
-            or abs(np.log(other.area_px / expected)) < abs(np.log(sherd.area_px / expected))
-        ):
-            sherd = other
+        sherd = _nearer_in_area(sherd, other, expected)
     near = hint_px if hint_px is not None else _centre(sherd.mask) if sherd is not None else None
     if (
         expected is not None
@@ -128,12 +124,7 @@ def analyse_rgb(
         # where it was put), within the sherd's length and the placing's play
         px_per_mm = r.px_per_cm / 10.0
         radius = (max(wrist_size_mm) + PLACE_PLAY_MM) * px_per_mm
-        other = sz.find_faint_sherd(seg, exclude, near, radius)
-        if other is not None and (
-            sherd is None
-            or abs(np.log(other.area_px / expected)) < abs(np.log(sherd.area_px / expected))
-        ):
-            sherd = other
+        sherd = _nearer_in_area(sherd, sz.find_faint_sherd(seg, exclude, near, radius), expected)
     if sherd is None:
         r.flags.append("sherd not found in the archival photo")
     else:
@@ -254,6 +245,17 @@ def locate_bar(rgb, feats, geometry: Geometry, chart, r: ArchivalResult):
 
 def _scale(loc, geometry):
     return ch.bar_px_per_cm(loc, geometry.bar)
+
+
+def _nearer_in_area(sherd, other, expected: float):
+    """Of two segmentations (size.SherdRegion or None), the one whose area is nearer, as a
+    ratio, the `expected` area in pixels: what the wrist camera saw chooses, never sizes."""
+    if other is None or (
+        sherd is not None
+        and abs(np.log(other.area_px / expected)) >= abs(np.log(sherd.area_px / expected))
+    ):
+        return sherd
+    return other
 
 
 def _centre(mask: np.ndarray) -> Tuple[float, float]:

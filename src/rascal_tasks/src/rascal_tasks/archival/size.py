@@ -25,6 +25,8 @@ SHADOW_PCT = 10.0  # darker pixels than this percentile are shadows
 # many L*a*b* units
 FAINT_SPREADS = 4.0
 MIN_FAINT_DISTANCE = 2.0
+_DISC5 = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
+_SEAM = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (11, 11))  # a paint's seam, closed
 
 
 @dataclass
@@ -62,24 +64,15 @@ def find_sherd(
     dist = np.sqrt(np.sum((smooth - table) ** 2, axis=2))
     spread = np.median(dist[::4, ::4][keep[::4, ::4]])
     cand = ((dist > max(MIN_DISTANCE, 5.0 * spread)) & keep).astype(np.uint8) * 255
-    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
-    cand = cv2.morphologyEx(cand, cv2.MORPH_OPEN, k)
+    cand = cv2.morphologyEx(cand, cv2.MORPH_OPEN, _DISC5)
     best = _pick(cand, hint_px)
     if best is None:
         return None
-    inner = cv2.erode(best, k, iterations=3) > 0
+    inner = cv2.erode(best, _DISC5, iterations=3) > 0
     contrast = float(np.median(dist[inner])) if inner.any() else float(np.median(dist[best > 0]))
-    edge = np.sqrt(np.sum((cv2.GaussianBlur(lab, (3, 3), 0) - table) ** 2, axis=2))
-    near = cv2.dilate(best, k, iterations=3) > 0
-    refined = ((edge > max(0.5 * MIN_DISTANCE, 0.5 * contrast)) & near & keep).astype(np.uint8)
-    refined = cv2.morphologyEx(refined * 255, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
-    region = _pick(refined, hint_px) if refined.any() else None
-    region = best if region is None else region
-    contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-    c = max(contours, key=cv2.contourArea)
-    mask = np.zeros_like(region)
-    cv2.drawContours(mask, [c], -1, 255, thickness=cv2.FILLED)  # holes (paint, glare) filled
-    return region_of(mask)
+    half_step = max(0.5 * MIN_DISTANCE, 0.5 * contrast)
+    refined = _edge_refined(lab, table, half_step, best, keep, hint_px)
+    return _filled(best if refined is None else refined, rgb8.shape[:2])
 
 
 def find_faint_sherd(
@@ -100,41 +93,52 @@ def find_faint_sherd(
     y0, y1 = int(max(0, hint_px[1] - r_out)), int(min(h, hint_px[1] + r_out + 1))
     if x1 - x0 < 8 or y1 - y0 < 8:
         return None
-    lab = cv2.GaussianBlur(_lab(rgb8[y0:y1, x0:x1]), (0, 0), 2.0)
+    lab = _lab(rgb8[y0:y1, x0:x1])
+    smooth = cv2.GaussianBlur(lab, (0, 0), 2.0)
     keep = np.ones(lab.shape[:2], bool) if exclude is None else exclude[y0:y1, x0:x1] == 0
     yy, xx = np.mgrid[y0:y1, x0:x1]
     r = np.hypot(xx - hint_px[0], yy - hint_px[1])
     ring = keep & (r >= 1.2 * radius_px) & (r <= r_out)
     if ring.sum() < 100:
         return None
-    table = np.median(lab[ring], axis=0)
-    dist = np.sqrt(np.sum((lab - table) ** 2, axis=2))
+    table = np.median(smooth[ring], axis=0)
+    dist = np.sqrt(np.sum((smooth - table) ** 2, axis=2))
     cut = max(MIN_FAINT_DISTANCE, FAINT_SPREADS * float(np.median(dist[ring])))
     cand = ((dist > cut) & keep & (r < 1.2 * radius_px)).astype(np.uint8) * 255
-    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
-    cand = cv2.morphologyEx(cand, cv2.MORPH_OPEN, k)
+    cand = cv2.morphologyEx(cand, cv2.MORPH_OPEN, _DISC5)
     # where a paint paler than the table meets a body darker than it, the smoothed colour
     # passes through the table's: a seam a few pixels wide, closed here
-    seam = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (11, 11))
-    cand = cv2.morphologyEx(cand, cv2.MORPH_CLOSE, seam)
+    cand = cv2.morphologyEx(cand, cv2.MORPH_CLOSE, _SEAM)
     hint = (hint_px[0] - x0, hint_px[1] - y0)
     best = _pick(cand, hint)
     if best is None:
         return None
     # its edge from the barely smoothed photo: smoothing spreads a bright paint's edge outwards
-    raw = cv2.GaussianBlur(_lab(rgb8[y0:y1, x0:x1]), (3, 3), 0)
-    edge = np.sqrt(np.sum((raw - table) ** 2, axis=2))
-    near = cv2.dilate(best, k, iterations=3) > 0
+    best = _edge_refined(lab, table, cut, best, keep, hint, seam=True)
+    return None if best is None else _filled(best, (h, w), (x0, y0))
+
+
+def _edge_refined(lab, table, cut, best, keep, hint_px, seam=False) -> Optional[np.ndarray]:
+    """`best`, a region found on the smoothed photo, with its edge put where the barely smoothed
+    `lab` lies farther than `cut` from the `table` colour, within a few pixels of it (smoothing
+    grows a bright region and shrinks a faint one); `seam`: a paint's seam closed again. None
+    when nothing is left."""
+    edge = np.sqrt(np.sum((cv2.GaussianBlur(lab, (3, 3), 0) - table) ** 2, axis=2))
+    near = cv2.dilate(best, _DISC5, iterations=3) > 0
     refined = ((edge > cut) & near & keep).astype(np.uint8) * 255
     refined = cv2.morphologyEx(refined, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
-    refined = cv2.morphologyEx(refined, cv2.MORPH_CLOSE, seam)
-    best = _pick(refined, hint) if refined.any() else None
-    if best is None:
-        return None
-    contours, _ = cv2.findContours(best, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-    mask = np.zeros((h, w), np.uint8)
-    c = max(contours, key=cv2.contourArea) + np.array([x0, y0])
-    cv2.drawContours(mask, [c], -1, 255, thickness=cv2.FILLED)  # holes (paint, glare) filled
+    if seam:
+        refined = cv2.morphologyEx(refined, cv2.MORPH_CLOSE, _SEAM)
+    return _pick(refined, hint_px) if refined.any() else None
+
+
+def _filled(region: np.ndarray, shape, offset=(0, 0)) -> SherdRegion:
+    """The largest outline of `region` (a window of the photo at `offset`), holes (paint, glare)
+    filled, as a photo-sized mask, measured."""
+    contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    mask = np.zeros(shape, np.uint8)
+    c = max(contours, key=cv2.contourArea) + np.array(offset)
+    cv2.drawContours(mask, [c], -1, 255, thickness=cv2.FILLED)
     return region_of(mask)
 
 
