@@ -13,6 +13,7 @@ import pytest
 
 from rascal_tasks.archival import analyse, analyse_rgb, chart, corrected_path
 from rascal_tasks.archival import colour as col
+from rascal_tasks.archival.analysis import Geometry, Placement
 from rascal_tasks.archival.munsell import soil_chart, within_one_chip
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -220,6 +221,35 @@ def test_a_plain_sherd_near_the_tables_colour_is_said_not_found_or_found_where_i
     r = analyse_rgb(rgb, wrist_size_mm=wrist, hint_px=tuple(put))
     assert r.length_mm == pytest.approx(truth["length_mm"], abs=1.5), r.flags
     assert r.width_mm == pytest.approx(truth["width_mm"], abs=1.5), r.flags
+
+
+@pytest.mark.parametrize("seed", [41, 44])
+def test_a_plain_sherd_near_the_tables_colour_is_looked_for_where_the_layout_put_it(seed):
+    """The recorder knows where on the table the chart, the bar and the placing spot lie (the
+    station's configuration): with the chart and the bar found in the photo, that is where the
+    sherd was put in it, whichever way the camera is turned (a camera looking down sees the
+    table mirrored). A layout whose chart and bar lie farther apart than the photo shows them
+    is not trusted: the sherd is then said not found, never measured somewhere else."""
+    rgb, truth = synthetic(seed, body_srgb=(132, 121, 102))
+    wrist = (truth["length_mm"] + 0.5, truth["width_mm"] - 0.5)
+    turn = np.random.default_rng(seed).uniform(-np.pi, np.pi)
+    turned = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    origin, px_per_m = np.array([700.0, 500.0]), truth["px_per_cm"] * 100.0
+
+    def on_table(px):  # photo = px_per_m * turned @ (x, -y) + origin
+        x, minus_y = turned.T @ (np.asarray(px, float) - origin) / px_per_m
+        return (x, -minus_y)
+
+    chart_xy, bar_xy = on_table(truth["chart"].mean(axis=0)), on_table(truth["bar"].mean(axis=0))
+    place_xy = on_table(np.asarray(truth["centre_px"], float) + (12.0, -9.0))  # a few mm off
+    layout = Geometry(placement=Placement(chart_xy, bar_xy, place_xy))
+    r = analyse_rgb(rgb, geometry=layout, wrist_size_mm=wrist)
+    assert r.length_mm == pytest.approx(truth["length_mm"], abs=1.5), r.flags
+    assert r.width_mm == pytest.approx(truth["width_mm"], abs=1.5), r.flags
+    moved = tuple(np.add(bar_xy, 1.3 * np.subtract(chart_xy, bar_xy)))  # chart moved away
+    untrusted = Geometry(placement=Placement(moved, bar_xy, place_xy))
+    r = analyse_rgb(rgb, geometry=untrusted, wrist_size_mm=wrist)
+    assert r.length_mm is None and "sherd not found in the archival photo" in r.flags
 
 
 def test_blank_image_gives_flags_not_exceptions(tmp_path):

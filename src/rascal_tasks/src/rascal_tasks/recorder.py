@@ -119,11 +119,18 @@ class Recorder:
 
     def use_archival_station(self, station):
         """The camera station's targets (chart and bar sizes, camera height; config.Station):
-        what the photo analysis may know. Where the targets lie is found in each photo."""
-        from rascal_tasks.archival.analysis import Geometry
+        what the photo analysis may know. Where the targets lie is found in each photo; where
+        they and the placing spot lie on the table says where the sherd was put in it (a
+        sherd of the table's colour is looked for there)."""
+        from rascal_tasks.archival.analysis import Geometry, Placement
         from rascal_tasks.archival.chart import BarSpec, ChartSpec
 
         cc, sb = station.colour_chart, station.scale_bar
+        placement = None
+        if cc is not None and sb is not None:
+            placement = Placement(
+                tuple(cc.area.center), tuple(sb.area.center), tuple(station.place_at)
+            )
         self.archival_geometry = Geometry(
             ChartSpec(cc.area.size[0] * 1000.0, cc.area.size[1] * 1000.0)
             if cc is not None
@@ -132,6 +139,7 @@ class Recorder:
             if sb is not None
             else BarSpec(),
             camera_height_m=station.camera_height,
+            placement=placement,
         )
 
     def wrist_size(self, seq) -> Optional[Tuple[float, float]]:

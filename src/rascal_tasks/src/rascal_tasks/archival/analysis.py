@@ -29,15 +29,51 @@ PLACE_PLAY_MM = 10.0
 SIZE_TOLERANCE_MM = 2.0  # archival and wrist length/width may differ by this ...
 SIZE_TOLERANCE_FRAC = 0.05  # ... or this share of the length, whichever is larger
 BAR_CHART_AGREEMENT = 0.04  # bar and chart scales may differ by this share (chart: 1 px edges)
+# the chart and the bar as far apart in the photo as the configuration says, within this share
+# of the bar's px/cm: else where the sherd was put is not taken from the configuration
+PLACEMENT_SCALE = 0.1
+
+
+@dataclass
+class Placement:
+    """Where on the table (station configuration, m, base_link) the chart's and the bar's
+    centres lie and the sherd is put: with the chart and the bar found in a photo, where the
+    sherd was put in it."""
+
+    chart_xy: Tuple[float, float]
+    bar_xy: Tuple[float, float]
+    place_xy: Tuple[float, float]
+
+    def in_photo(self, chart_px, bar_px, px_per_cm: float) -> Optional[Tuple[float, float]]:
+        """The placing spot in photo pixels, through the similarity that takes the chart's
+        and the bar's centres to where the photo shows them (mirrored: a camera looking
+        down sees the table's y against its image rows, whichever way it is turned). None
+        when its scale is not the bar's within PLACEMENT_SCALE (the targets do not lie as
+        configured)."""
+
+        def table(p):
+            return complex(p[0], -p[1])
+
+        apart = table(self.chart_xy) - table(self.bar_xy)
+        if abs(apart) < 1e-3:
+            return None
+        a = (complex(*chart_px) - complex(*bar_px)) / apart  # px per m, and the turn
+        if abs(abs(a) / (px_per_cm * 100.0) - 1.0) > PLACEMENT_SCALE:
+            return None
+        z = complex(*chart_px) + a * (table(self.place_xy) - table(self.chart_xy))
+        return z.real, z.imag
 
 
 @dataclass
 class Geometry:
-    """What the station's configuration says (optional; sizes of the targets, not where)."""
+    """What the station's configuration says (optional): sizes of the targets, the camera's
+    height and where the sherd is put (`placement`: only to look for a sherd that nothing of
+    stood out from the whole photo)."""
 
     chart: ch.ChartSpec = ch.ChartSpec()
     bar: ch.BarSpec = ch.BarSpec()
     camera_height_m: float = 0.0  # lens above the table (parallax of the sherd's outline)
+    placement: Optional[Placement] = None
 
 
 @dataclass
@@ -114,6 +150,11 @@ def analyse_rgb(
         other = sz.find_sherd(seg, exclude, hint_px, lightness_weight=SHADOW_LIGHTNESS_WEIGHT)
         sherd = _nearer_in_area(sherd, other, expected)
     near = hint_px if hint_px is not None else _centre(sherd.mask) if sherd is not None else None
+    if near is None and geometry.placement is not None and chart is not None and bar is not None:
+        # nothing of it stood out: where the station's configuration says it was put
+        near = geometry.placement.in_photo(
+            chart.corners().mean(axis=0), bar.corners().mean(axis=0), r.px_per_cm
+        )
     if (
         expected is not None
         and near is not None
