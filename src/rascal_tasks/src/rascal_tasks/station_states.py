@@ -3,6 +3,8 @@ STATION_i runs the station's plug-in (`stations.py`), REPICK_i picks it up again
 takes two sherds lifted as one back to the pickup mat, apart. No ROS here.
 """
 
+from typing import Optional, Tuple
+
 from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
 from rascal_tasks.manipulation import grasp, placed_observation, release
@@ -220,15 +222,40 @@ class PutBack(BatchState):
         b = self.batch
         s = b.sherd
         if held is None:
-            yaw, height, width = s.grasp_yaw, s.grasp_height, s.width
+            set_down_on_mat(b, x, y, s.grasp_yaw, s.grasp_height, s.width)
         else:
-            yaw, height, width = held.grasp_yaw, held.grasp_z - b.pickup.surface_z, held.width
-        b.move_down(x, y, b.travel_z(), yaw)
-        low = b.pickup.surface_z + height + b.config["arm"]["place_clearance"]
-        b.move_down(x, y, low, yaw, linear=True)
-        with b.phase("grasping"):
-            release(b, width)
-        b.move_down(x, y, b.travel_z(), yaw, linear=True)
+            height = held.grasp_z - b.pickup.surface_z
+            set_down_on_mat(b, x, y, held.grasp_yaw, height, held.width)
+
+
+def set_down_on_mat(b, x, y, yaw, height, width):
+    """Carry what is in the fingers (held `height` above what it lies on, `width` wide) to
+    (x, y) of the pickup mat and let it go just above."""
+    b.move_down(x, y, b.travel_z(), yaw)
+    low = b.pickup.surface_z + height + b.config["arm"]["place_clearance"]
+    b.move_down(x, y, low, yaw, linear=True)
+    with b.phase("grasping"):
+        release(b, width)
+    b.move_down(x, y, b.travel_z(), yaw, linear=True)
+
+
+def clear_to_mat(b, st) -> Optional[Tuple[float, float]]:
+    """A sherd left lying on station `st` (the fingers empty) taken back to the freest spot of
+    the pickup mat, where a later survey finds it like any other; that spot, or None when the
+    wrist camera sees nothing there or it could not be picked up."""
+    seen = survey_at(b, st, *st.place_at)
+    if not seen:
+        return None
+    o = seen[0]
+    try:
+        if not grasp(b, o, st):
+            return None
+    except SherdFailure:
+        return None  # its grasp was refused: it stays, and is said
+    x, y = free_spot(b.pickup.area, b.seen)
+    set_down_on_mat(b, x, y, o.grasp_yaw, o.grasp_z - st.surface_z, o.width)
+    b.pending_stale = True  # the mat changed: the next pick looks again
+    return x, y
 
 
 def free_spot(area, seen, step=0.01, inset=0.035):

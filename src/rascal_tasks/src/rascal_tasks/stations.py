@@ -189,12 +189,47 @@ class ScaleStation(StationPlugin):
         empty = self._settled_now(b.rig.clock.now() - cfg["stable_window"] - 1.0)
         if empty is None:
             return
+        if empty.mass >= MIN_SHERD_MASS and self._left_on_pan(empty.mass):
+            return  # the next sherd's tare is done above the scale
         try:
             b.rig.scale.tare()
         except RigError as e:  # tared again, and said, when the next sherd is above the scale
             b.log("early tare of the scale failed: %s" % e)
             return
         self._early_tare = (b.rig.clock.now(), empty.mass)
+
+    def _left_on_pan(self, kg: float) -> bool:
+        """`kg` lies on the pan, settled, since the sherd weighed here was lifted off it: a
+        sherd that came with it (lying on it in a heap) and stayed. Its mass was weighed with
+        the sherd's, whose own is the difference (recorded while the sherd is not yet
+        photographed, else noted). The other is taken back to the pickup mat, to be recorded
+        as its own sherd (station_states.clear_to_mat). True when the pan was cleared."""
+        b = self.batch
+        s = b.sherd
+        if s is not None and s.mass is not None and self._tared_for == s.seq:
+            own = s.mass - kg
+            text = (
+                "%.1f g stayed on the scale when it was lifted off: weighed with it (%.1f g); "
+                "its own mass by difference %.1f g" % (kg * 1000, s.mass * 1000, own * 1000)
+            )
+            if own >= MIN_SHERD_MASS and s.status == "weighed":
+                s.record_mass(round(own, 7))
+                text += ", recorded"
+            b.event(s, "left_on_scale", text)
+        # imported here: station_states imports this module
+        from rascal_tasks.station_states import clear_to_mat
+
+        spot = clear_to_mat(b, self.station)
+        if spot is None:
+            b.event(s, "left_on_scale", "not seen or not picked up there: weighed over it")
+            return False
+        b.event(
+            s,
+            "cleared",
+            "what stayed on the scale taken to the pickup mat at "
+            "(%.3f, %.3f) m, to be recorded as its own sherd" % spot,
+        )
+        return True
 
     def _early_tare_holds(self) -> bool:
         """Whether while_away's tare (if any) still holds: since it, the pan has read zero

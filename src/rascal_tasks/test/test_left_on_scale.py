@@ -1,0 +1,24 @@
+"""A sherd that rode onto the scale lying on the one grasped, weighed with it (within the
+one-sherd mass bound), and stayed on the pan when that one was lifted off (batch tier, on the
+in-memory rig): the row gets its own sherd's mass by difference, and the other is taken back to
+the pickup mat and recorded as its own sherd, never weighed over or picked up in its place."""
+
+import pytest
+from fake_rig import Sherd, World, run_batch, shipped_config
+
+
+def test_a_sherd_left_on_the_scale_is_weighed_out_and_taken_back_to_the_mat():
+    config = shipped_config()
+    # 60 x 50 mm, 9 mm wall: one such sherd may weigh up to ~68 g, so 45 g passes as one
+    big = Sherd("big", 0.14, 0.24, length=0.06, width=0.05, thickness=0.009, mass=0.030)
+    rider = Sherd("rider", 0.14, 0.24, length=0.04, width=0.03, mass=0.015)
+    world = World(config, [big, rider])
+    world.doubles = {"big": "rider"}  # the first grasp of `big` lifts `rider` too
+    outcome, _batch, rec = run_batch(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert rec.sherds[1].mass == pytest.approx(0.030)  # 45 g weighed, 15 g stayed on the pan
+    assert rec.sherds[2].mass == pytest.approx(0.015)  # weighed on its own, later
+    assert any(n.startswith("left_on_scale: 15.0 g stayed") for n in rec.sherds[1].notes)
+    assert any(n.startswith("cleared: ") for n in rec.sherds[1].notes)
+    assert {s.station for s in world.sherds} == {"discard"}
