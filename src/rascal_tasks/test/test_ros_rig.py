@@ -89,3 +89,44 @@ def test_a_transform_not_there_yet_is_waited_for_then_said_in_one_line():
         "TF base_link -> camera_color_optical_frame: Lookup would require extrapolation into "
         "the future."
     )
+
+
+def _camera(answer, exposed_after=None):
+    """A RosArchivalCamera whose service answers `answer` (after saying its shutter closed,
+    when `exposed_after` is a delay in s), no master needed."""
+    import threading
+    import time
+
+    from rascal_tasks.ros_rig import RosArchivalCamera
+
+    cam = RosArchivalCamera.__new__(RosArchivalCamera)
+    cam.timeout, cam._stop, cam._exposed = 5.0, None, threading.Event()
+
+    def service(path, ev):
+        if exposed_after is not None:
+            time.sleep(exposed_after)
+            cam._exposed.set()
+        time.sleep(0.05)  # the transfer
+        return answer
+
+    cam._capture = service
+    return cam
+
+
+def test_the_arm_moves_during_a_capture_only_once_its_shutter_closed_or_a_photo_came():
+    from types import SimpleNamespace
+
+    from rascal_tasks.rig import RigError
+
+    photo = SimpleNamespace(
+        success=True, path="/a.png", stamp=SimpleNamespace(to_sec=lambda: 1.0), width=4, height=3
+    )
+    moves = []
+    assert _camera(photo, exposed_after=0.02).capture_while("/a.png", 0.0, lambda: moves.append(1))
+    assert moves == [1]  # during the transfer
+    assert _camera(photo).capture_while("/a.png", 0.0, lambda: moves.append(2)).path == "/a.png"
+    assert moves == [1, 2]  # a camera that never says: once the photo came
+    refused = SimpleNamespace(success=False, message="arm in view: move to standby")
+    with pytest.raises(RigError) as e:
+        _camera(refused).capture_while("/a.png", 0.0, lambda: moves.append(3))
+    assert e.value.code == "REFUSED" and moves == [1, 2]  # a refusal moves nothing

@@ -447,7 +447,7 @@ class RosArchivalCamera(rig.ArchivalCamera):
         deadline = dl.Deadline(self.timeout, dl.ros_time)
         answer = (deadline, self._stop, self.SERVICE, "FAILED", self.NODE, self.SERVICE)
         self._exposed.clear()
-        self._since = rospy.get_time()  # a shutter from before this call is not this one's
+        self._since = dl.ros_time()  # a shutter from before this call is not this one's
         pending = dl.Background(self._capture, path, exposure_ev)
         moved = during is None
         if not moved:
@@ -457,7 +457,8 @@ class RosArchivalCamera(rig.ArchivalCamera):
                 deadline,
                 self._stop,
             )
-            if outcome == dl.DONE and not pending.failed():
+            # a refusal (arm in view, another capture running) runs no move
+            if outcome == dl.DONE and self._exposed_or_answered(pending, deadline):
                 moved = True
                 try:
                     during()
@@ -473,6 +474,12 @@ class RosArchivalCamera(rig.ArchivalCamera):
         if not moved:
             during()  # the answer came before the word that the shutter closed
         return rig.Capture(res.path, res.stamp.to_sec(), res.width, res.height)
+
+    def _exposed_or_answered(self, pending, deadline) -> bool:
+        """The shutter of this capture has closed, or the camera answered with a photo."""
+        if self._exposed.is_set():
+            return True
+        return not pending.failed() and bool(pending.result(deadline).success)
 
 
 class RosClock(rig.Clock):
