@@ -80,6 +80,9 @@ class Batch:
             STATION_PLUGINS[config.stations[n].type](config.stations[n], self)
             for n in self.station_names
         ]
+        for before, plugin in zip(self.plugins, self.plugins[1:], strict=False):
+            if plugin.station.over_scale:  # the camera shoots the sherd where the scale has it
+                plugin.lies_at = before.lies_at
         self.pickup = next(s for s in config.stations.values() if s.type == "pickup")
 
     @contextlib.contextmanager
@@ -127,6 +130,10 @@ class Batch:
 
     def travel_z(self) -> float:
         return self.config["arm"]["travel_z"]
+
+    def route(self) -> list:
+        """The stations a sherd is carried to and set down at, in order (config Stations)."""
+        return [p.station for p in self.plugins if not p.stays]
 
     def in_the_way(self, station) -> bool:
         """Whether a sherd left lying on `station` lies where a later sherd is placed."""

@@ -19,12 +19,13 @@ import hashlib
 import json
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Dict, List, Optional, Tuple
 
 import yaml
 
 from rascal_workcell import schema, urdf_model
+from rascal_workcell.fixtures import SCALE_HOUSING_MARGIN
 
 from rascal_tasks.sorting import Rule, RuleError, parse_rule
 from rascal_tasks.stations import STATION_PLUGINS
@@ -106,6 +107,7 @@ class Station:
     stand: Optional[Fixture] = None
     rule: Optional[Rule] = None  # a sorting bin's (sorting.py)
     place_yaw: Optional[float] = None  # [rad] gripper yaw of a taught place (else as picked up)
+    over_scale: bool = False  # an archival camera that photographs the sherd on the scale
 
 
 @dataclass(frozen=True)
@@ -266,6 +268,7 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
             extra["colour_chart"] = Fixture(_rect(st["colour_chart"]))
             extra["scale_bar"] = Fixture(_rect(st["scale_bar"]))
             extra["stand"] = Fixture(_rect(st["stand"]), st["stand"]["height"])
+            extra["over_scale"] = bool(st.get("over_scale", False))
             for part in ("colour_chart", "scale_bar"):
                 if not area.contains(extra[part].area):
                     _fail(
@@ -314,9 +317,13 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
 
     for type_ in REQUIRED_STATION_TYPES:
         _only(source, stations, type_)
+    cam = stations[_only(source, stations, "archival_camera")]
+    one_station = _scale_under_camera(source, sec, stations, cam) if cam.over_scale else ()
     names = list(stations)
     for i, a in enumerate(names):
         for b in names[i + 1 :]:
+            if {a, b} == set(one_station):
+                continue
             if stations[a].area.overlaps(stations[b].area):
                 _fail(
                     source,
@@ -324,7 +331,6 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
                     "overlaps station %s %s; move one of them" % (a, _fmt_rect(stations[a].area)),
                     _fmt_rect(stations[b].area),
                 )
-    cam = stations[_only(source, stations, "archival_camera")]
     for name, s in stations.items():
         if s is not cam and s.area.overlaps(cam.stand.area):
             _fail(
@@ -335,6 +341,60 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
             )
     _check_markers(source, sec, stations, cam)
     return stations
+
+
+def _scale_under_camera(source: str, sec: dict, stations: Dict[str, Station], cam: Station):
+    """The one-station layout (`over_scale`): the scale's platform lies in the camera's view,
+    clear of the chart and the bar (its housing too), the camera right after the scale in the
+    station order, and the sherd set down once, at the camera's place_at on the platform (the
+    scale's place becomes it). Returns the pair of station names whose areas may overlap."""
+    key = "stations.%s.over_scale" % cam.name
+    scale = stations[_only(source, stations, "scale")]
+    order = [n for n, s in stations.items() if s.type not in ("pickup", "bin")]
+    if order.index(cam.name) != order.index(scale.name) + 1:
+        _fail(
+            source,
+            key,
+            "the camera must come right after the scale %s in the station list (the sherd is "
+            "photographed where it was weighed); move its section" % scale.name,
+            True,
+        )
+    if not cam.area.contains(scale.area):
+        _fail(
+            source,
+            "stations.%s.position" % scale.name,
+            "with %s: true the scale's platform must lie inside the camera's field of view %s"
+            % (key, _fmt_rect(cam.area)),
+            _fmt_rect(scale.area),
+        )
+    housing = Rect(scale.area.center, tuple(v + 2 * SCALE_HOUSING_MARGIN for v in scale.area.size))
+    for part in ("colour_chart", "scale_bar"):
+        fixture = getattr(cam, part).area
+        if fixture.overlaps(housing):
+            _fail(
+                source,
+                "stations.%s.%s" % (cam.name, part),
+                "lies on the scale or its housing %s; put it beside the scale" % _fmt_rect(housing),
+                _fmt_rect(fixture),
+            )
+    if not scale.area.has(cam.place_at):
+        _fail(
+            source,
+            "stations.%s.place_at" % cam.name,
+            "with %s: true the sherd is photographed where it is weighed: put place_at on the "
+            "scale's platform %s" % (key, _fmt_rect(scale.area)),
+            list(cam.place_at),
+        )
+    if sec[scale.name].get("taught_place") is not None:
+        _fail(
+            source,
+            "stations.%s.taught_place" % scale.name,
+            "with %s: true the sherd is set down at the camera's place; remove it and teach "
+            "the camera station (`rascal teach %s`)" % (key, cam.name),
+            sec[scale.name]["taught_place"],
+        )
+    stations[scale.name] = replace(scale, place_at=cam.place_at, place_yaw=cam.place_yaw)
+    return scale.name, cam.name
 
 
 def _taught_place(source: str, key: str, st: dict, area: Rect, surface_z: float):

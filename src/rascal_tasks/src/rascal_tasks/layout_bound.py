@@ -75,36 +75,40 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
         Step("descend", (px, py, z0), wait=margin_stroke),  # close
         Step("lift", (px, py, travel)),
     ]
-    for name in cfg.station_order():
+    order = cfg.station_order()
+    for name, after in zip(order, order[1:] + [None], strict=True):
         st = cfg.stations[name]
-        x, y = st.place_at
         if st.type == "discard":
+            x, y = st.place_at
             steps.append(Step("over discard", (x, y, travel), wait=margin_stroke))  # let go
             continue
-        z = st.surface_z + GRASP_HEIGHT + arm["place_clearance"]
+        if not st.over_scale:  # over the scale it is shot where it lies, from the hover
+            x, y = st.place_at
+            z = st.surface_z + GRASP_HEIGHT + arm["place_clearance"]
+            steps.append(Step("over " + name, (x, y, travel)))  # a scale tared meanwhile
+            steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke))
         if st.type == "scale":
-            steps.append(Step("over scale", (x, y, travel)))  # tared while the arm was away
-            steps.append(Step("place on scale", (x, y, z), wait=margin_stroke))
             settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
             steps.append(Step("hover", (x, y, z + approach), wait=settle))  # while it settles
-            steps.append(Step("settled; descend", (x, y, z), wait=margin_stroke))
-        else:
-            steps.append(Step("over " + name, (x, y, travel)))
-            steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke))
-            steps.append(Step("lift", (x, y, travel)))
-            if st.type == "archival_camera":
-                sx, sy = arm["standby"]
-                steps.append(
-                    Step(
-                        "standby",
-                        (sx, sy, travel),
-                        wait=SHUTTER,
-                        serial_wait=TRANSFER,
-                        overlaps_next=True,
-                    )
+            if after is not None and cfg.stations[after].over_scale:
+                continue  # the camera over it takes it from here
+        elif st.type == "archival_camera":
+            if not st.over_scale:
+                steps.append(Step("lift", (x, y, travel)))
+            sx, sy = arm["standby"]
+            steps.append(
+                Step(
+                    "standby",
+                    (sx, sy, travel),
+                    wait=SHUTTER,
+                    serial_wait=TRANSFER,
+                    overlaps_next=True,
                 )
-                steps.append(Step("back over " + name, (x, y, z + approach)))
-            steps.append(Step("descend", (x, y, z), wait=margin_stroke))
+            )
+            steps.append(Step("back over " + name, (x, y, z + approach)))
+        else:
+            steps.append(Step("lift", (x, y, travel)))
+        steps.append(Step("descend", (x, y, z), wait=margin_stroke))
         steps.append(Step("lift", (x, y, travel)))
     return steps
 

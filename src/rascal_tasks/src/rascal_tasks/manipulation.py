@@ -134,7 +134,7 @@ def grasp_retrying(b, o: Observation, station, like=None):
     like = like or (lambda c, last: c.distance_to(last.x, last.y))
     for attempt in range(rec["max_grasp_attempts"]):
         if station is b.pickup:  # the grasp turned by pi is the same grasp
-            route = [p.station for p in b.plugins]
+            route = b.route()
             yaw = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
             if yaw != o.grasp_yaw:
                 o = dataclasses.replace(o, grasp_yaw=yaw)

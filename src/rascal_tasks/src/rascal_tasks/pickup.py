@@ -153,7 +153,7 @@ def look_from(b, o: Observation) -> Tuple[float, float, Optional[float]]:
     facing away from the base; else the survey's view nearest it, which saw it before (the far
     corners of the mat are out of reach at the survey height)."""
     z = b.pickup.surface_z + b.config["survey"]["z"]
-    route = [p.station for p in b.plugins]
+    route = b.route()
     g = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
     for yaw in (g, math.remainder(g + math.pi, 2.0 * math.pi), None):
         ex, ey, _ = gripper_for_camera_over(o.x, o.y, yaw)

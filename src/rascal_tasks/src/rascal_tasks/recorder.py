@@ -117,12 +117,14 @@ class Recorder:
         tag = owner_tag(self.catalogue.identity())
         return os.path.join(spool, "%s-%d-%s.png" % (context_folder(self.context), seq, tag))
 
-    def use_archival_station(self, station):
+    def use_archival_station(self, station, lies_on=None):
         """The camera station's targets (chart and bar sizes, camera height; config.Station):
         what the photo analysis may know. Where the targets lie is found in each photo; where
         they and the placing spot lie on the table says where the sherd was put in it (a
-        sherd of the table's colour is looked for there)."""
-        from rascal_tasks.archival.analysis import Geometry, Placement
+        sherd of the table's colour is looked for there). `lies_on`: the station the sherd
+        lies on in the photo, when not the camera's (the scale under it): only that is
+        looked at, and it lies higher than the targets."""
+        from rascal_tasks.archival.analysis import Geometry, Placement, Support
         from rascal_tasks.archival.chart import BarSpec, ChartSpec
 
         cc, sb = station.colour_chart, station.scale_bar
@@ -140,6 +142,13 @@ class Recorder:
             else BarSpec(),
             camera_height_m=station.camera_height,
             placement=placement,
+            support=None
+            if lies_on is None or lies_on is station
+            else Support(
+                tuple(lies_on.area.center),
+                tuple(lies_on.area.size),
+                lies_on.surface_z - station.surface_z,
+            ),
         )
 
     def wrist_size(self, seq) -> Optional[Tuple[float, float]]:

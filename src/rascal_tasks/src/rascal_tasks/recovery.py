@@ -85,8 +85,8 @@ class Recover(BatchState):
             # Lifted from a station after it was measured: it was never above the pickup area
             # again. It fell where it was lifted, or where it was carried to.
             nxt = s.station_index + 1
-            if nxt < len(b.plugins) and b.plugins[nxt].station is not where:
-                places.append((b.plugins[nxt].station, b.plugins[nxt].station.place_at))
+            if nxt < len(b.plugins) and b.plugins[nxt].lies_at is not where:
+                places.append((b.plugins[nxt].lies_at, b.plugins[nxt].lies_at.place_at))
         elif s.picked_xy is not None and (where is not b.pickup or s.picked_xy != s.last_xy):
             places.append((b.pickup, s.picked_xy))
         for station, xy in places:

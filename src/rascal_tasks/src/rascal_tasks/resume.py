@@ -78,6 +78,8 @@ class Calibrate(BatchState):
         b = self.batch
         for plugin in b.plugins:
             st = plugin.station
+            if plugin.stays:
+                continue  # it sees the station before: learnt there
             camera_over(b, st, *st.place_at)
             if not plugin.release_from_above:
                 seen = b.rig.perception.detect_if_calibrated(st.name)
@@ -134,14 +136,21 @@ class Resume(BatchState):
         if b.put_back and b.put_back[0] == seq:
             return self.pick_put_back(s, done)
         for i in range(max(done, 0), len(b.plugins)):
-            st = b.plugins[i].station
-            if b.plugins[i].release_from_above:
+            plugin = b.plugins[i]
+            st = plugin.lies_at
+            if plugin.release_from_above:
                 break
+            if plugin.stays and i > done:
+                continue  # where the station before looked
             seen = survey_at(b, st, *st.place_at)
             if seen:
                 s.seen(seen[0], st)
                 s.station_done(done)
-                return ("REPICK_%d" if i == done else "STATION_%d") % i
+                if i != done:
+                    return "STATION_%d" % i
+                # measured here; a camera over the scale shoots it where it lies
+                stays = i + 1 < len(b.plugins) and b.plugins[i + 1].stays
+                return ("STATION_%d" if stays else "REPICK_%d") % (i + stays)
         if done < 0 and self.pick_fallen(s, pickup_xy):
             return "TRANSLATE_0"
         s.lose("not found after restart (was %s)" % status)

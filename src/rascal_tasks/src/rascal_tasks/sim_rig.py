@@ -70,7 +70,8 @@ class RosMaster:
 
 
 class SimRig:
-    """The simulated rig. `env` talks to its master; `params` are set after the config."""
+    """The simulated rig. `env` talks to its master; `over`: YAML files loaded over the config
+    (a layout's keys); `params` are set after them."""
 
     def __init__(
         self,
@@ -81,6 +82,7 @@ class SimRig:
         nodes=NODES,
         ready=READY,
         ws=None,
+        over=(),
     ):
         self.ws = ws or workspace()
         self.procs = []  # the rig's nodes: one that exits while a service is awaited is a fault
@@ -97,6 +99,8 @@ class SimRig:
             self.env = dict(master_env, ROS_HOME=self.log_dir)
         try:
             self.run(["rosparam", "load", os.path.join(self.ws, "config", "rascal.yaml")])
+            for layer in over:  # e.g. config/layouts/one_station.yaml: merged over it
+                self.run(["rosparam", "load", os.path.abspath(layer)])
             self.set_param("/use_sim_time", True)
             self.run(
                 [
@@ -214,6 +218,13 @@ def main(argv=None) -> int:
     p.add_argument("--scenario", help="scenario YAML (default: simulator.scenario of the config)")
     p.add_argument("--rtf", type=float, help="simulator real-time factor (0 = fast as possible)")
     p.add_argument(
+        "--over",
+        action="append",
+        default=[],
+        metavar="YAML",
+        help="loaded over config/rascal.yaml, e.g. config/layouts/one_station.yaml",
+    )
+    p.add_argument(
         "--set",
         action="append",
         default=[],
@@ -229,7 +240,7 @@ def main(argv=None) -> int:
         key, _, value = item.partition("=")
         params[key] = yaml.safe_load(value)
     cmd = [c for c in args.command if c != "--"]
-    with SimRig(scenario=args.scenario, params=params) as rig:
+    with SimRig(scenario=args.scenario, params=params, over=args.over) as rig:
         if not cmd:
             print("rig up; Ctrl-C to stop (ROS_MASTER_URI=%s)" % rig.env["ROS_MASTER_URI"])
             try:

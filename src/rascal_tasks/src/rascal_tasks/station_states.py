@@ -89,12 +89,13 @@ class AtStation(BatchState):
         plugin = b.plugins[self.index]
         s = b.sherd
         for earlier in b.plugins[: self.index]:
-            earlier.while_away()
+            if earlier.lies_at is not plugin.lies_at:  # not the scale with the sherd on it
+                earlier.while_away()
         if plugin.station.type == "archival_camera":
             # the photo's analysis learns the chart's and bar's sizes (not where they lie)
             use = getattr(b.recorder, "use_archival_station", None)
             if use is not None and getattr(b.recorder, "archival_geometry", 0) is None:
-                use(plugin.station)
+                use(plugin.station, plugin.lies_at)
         outcome = plugin.after_place(s)
         if outcome == "missing":
             s.dropped("not at the %s after placing" % plugin.station.name)
@@ -133,7 +134,7 @@ def repick(b, index) -> bool:
     first (where it was placed, as it was held), then from a fresh look on each miss. False,
     with the sherd recorded lost, when it could not be taken."""
     s = b.sherd
-    st = b.config.stations[b.station_names[index]]
+    st = b.plugins[index].lies_at
     x, y = s.last_xy
     o = placed_observation(b, s, st)
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):

@@ -55,6 +55,14 @@ class StationPlugin:
     def __init__(self, station, batch):
         self.station = station  # rascal_tasks.config.Station
         self.batch = batch  # rascal_tasks.batch.Batch
+        # the station the sherd lies on while this one works: this one, or the scale for a
+        # camera over it (`over_scale`: Batch sets it), where the sherd stays
+        self.lies_at = station
+
+    @property
+    def stays(self) -> bool:
+        """The sherd is not carried here: it lies where the station before set it down."""
+        return self.lies_at is not self.station
 
     def target(self, sherd):
         """The station the sherd is carried to and set down at: this one (the discard station
@@ -76,7 +84,7 @@ class StationPlugin:
         # imported here: manipulation -> survey -> batch imports this module
         from rascal_tasks.manipulation import placed_observation, reach
 
-        reach(self.batch, placed_observation(self.batch, sherd, self.station))
+        reach(self.batch, placed_observation(self.batch, sherd, self.lies_at))
 
     def after_place(self, sherd) -> str:
         """Called with the sherd placed and the gripper back at travel height; records what it
@@ -377,7 +385,8 @@ class ArchivalCameraStation(StationPlugin):
 
     def after_place(self, sherd):
         b = self.batch
-        self.at_sherd = False  # placing lifted the arm to travel height
+        # placing lifted the arm to travel height; on the scale it waits just above the sherd
+        self.at_sherd = self.stays
         with b.phase("data_collection"):
             capture = self._capture(sherd, sherd.spool_path())
             if capture is None:

@@ -73,6 +73,8 @@ def build_machine(batch: Batch):
         add("PICKUP", Pickup(batch), held="TRANSLATE_0", missed="SURVEY")
         for i in range(n):
             last = i == n - 1
+            # a camera over the scale shoots the sherd where it was weighed: no repick, no carry
+            after = "STATION_%d" % (i + 1) if not last and batch.plugins[i + 1].stays else None
             add(
                 "TRANSLATE_%d" % i,
                 Translate(batch, i),
@@ -83,7 +85,7 @@ def build_machine(batch: Batch):
             add(
                 "STATION_%d" % i,
                 AtStation(batch, i),
-                done="SURVEY_NEXT" if last else "REPICK_%d" % i,
+                done="SURVEY_NEXT" if last else after or "REPICK_%d" % i,
                 dropped="RECOVER_%d" % i,
                 lost="SURVEY_NEXT",
                 double="PUT_BACK_%d" % i,

@@ -45,11 +45,16 @@ def standby_yaw(config, station) -> float:
 
 def station_yaw(config, station, held_yaw: float) -> float:
     """The gripper's yaw at a station: the taught one (`rascal teach`); under the archival
-    camera the standby's; elsewhere as the sherd is held (no wrist turn on the way)."""
+    camera (also on a scale under it, `over_scale`) the standby's; elsewhere as the sherd is
+    held (no wrist turn on the way)."""
     if station.place_yaw is not None:
         return station.place_yaw
     if station.type == "archival_camera":
         return standby_yaw(config, station)
+    if station.type == "scale":
+        camera = next(s for s in config.stations.values() if s.type == "archival_camera")
+        if camera.over_scale:
+            return standby_yaw(config, camera)
     return held_yaw
 
 

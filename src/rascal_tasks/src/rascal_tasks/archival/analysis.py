@@ -32,6 +32,11 @@ BAR_CHART_AGREEMENT = 0.04  # bar and chart scales may differ by this share (cha
 # the chart and the bar as far apart in the photo as the configuration says, within this share
 # of the bar's px/cm: else where the sherd was put is not taken from the configuration
 PLACEMENT_SCALE = 0.1
+# a platform the sherd lies on in the photo (the scale under the camera) is looked at this far
+# inside its configured outline: its rim and the housing stay out, and the similarity's error
+# (0.3-1.9 mm on the bench photos) and the platform's nearness to the lens (it looks ~5 % larger
+# than the chart's plane) only move the edge further in
+SUPPORT_INSET = 0.012  # m
 
 
 @dataclass
@@ -44,12 +49,14 @@ class Placement:
     bar_xy: Tuple[float, float]
     place_xy: Tuple[float, float]
 
-    def in_photo(self, chart_px, bar_px, px_per_cm: float) -> Optional[Tuple[float, float]]:
-        """The placing spot in photo pixels, through the similarity that takes the chart's
-        and the bar's centres to where the photo shows them (mirrored: a camera looking
-        down sees the table's y against its image rows, whichever way it is turned). None
-        when its scale is not the bar's within PLACEMENT_SCALE (the targets do not lie as
-        configured)."""
+    def in_photo(
+        self, chart_px, bar_px, px_per_cm: float, xy=None
+    ) -> Optional[Tuple[float, float]]:
+        """The placing spot (or the table point `xy`) in photo pixels, through the similarity
+        that takes the chart's and the bar's centres to where the photo shows them (mirrored:
+        a camera looking down sees the table's y against its image rows, whichever way it is
+        turned). None when its scale is not the bar's within PLACEMENT_SCALE (the targets do
+        not lie as configured)."""
 
         def table(p):
             return complex(p[0], -p[1])
@@ -60,20 +67,39 @@ class Placement:
         a = (complex(*chart_px) - complex(*bar_px)) / apart  # px per m, and the turn
         if abs(abs(a) / (px_per_cm * 100.0) - 1.0) > PLACEMENT_SCALE:
             return None
-        z = complex(*chart_px) + a * (table(self.place_xy) - table(self.chart_xy))
+        xy = self.place_xy if xy is None else xy
+        z = complex(*chart_px) + a * (table(xy) - table(self.chart_xy))
         return z.real, z.imag
+
+
+@dataclass
+class Support:
+    """What the sherd lies on when it is not the table around the targets: the scale's
+    platform under the camera (`over_scale`), its outline on the table (m, base_link) and its
+    top above the chart's and bar's plane."""
+
+    center: Tuple[float, float]
+    size: Tuple[float, float]
+    height_m: float
+
+    def outline(self, inset: float) -> List[Tuple[float, float]]:
+        hx, hy = self.size[0] / 2 - inset, self.size[1] / 2 - inset
+        cx, cy = self.center
+        return [(cx - hx, cy - hy), (cx + hx, cy - hy), (cx + hx, cy + hy), (cx - hx, cy + hy)]
 
 
 @dataclass
 class Geometry:
     """What the station's configuration says (optional): sizes of the targets, the camera's
     height and where the sherd is put (`placement`: only to look for a sherd that nothing of
-    stood out from the whole photo)."""
+    stood out from the whole photo), and what it lies on when that is not the table
+    (`support`: the sherd is looked for only on it; needs `placement`)."""
 
     chart: ch.ChartSpec = ch.ChartSpec()
     bar: ch.BarSpec = ch.BarSpec()
     camera_height_m: float = 0.0  # lens above the table (parallax of the sherd's outline)
     placement: Optional[Placement] = None
+    support: Optional[Support] = None
 
 
 @dataclass
@@ -102,6 +128,23 @@ class ArchivalResult:
             )
         parts.extend(self.flags)
         return "; ".join(parts)
+
+
+def _support_mask(shape, geometry: Geometry, chart, bar, px_per_cm) -> Optional[np.ndarray]:
+    """uint8 0/255: the support's outline (SUPPORT_INSET inside its edge) in the photo, placed
+    through the chart and the bar; None when they were not found as configured."""
+    if geometry.placement is None or chart is None or bar is None or px_per_cm is None:
+        return None
+    chart_px, bar_px = chart.corners().mean(axis=0), bar.corners().mean(axis=0)
+    corners = [
+        geometry.placement.in_photo(chart_px, bar_px, px_per_cm, xy)
+        for xy in geometry.support.outline(SUPPORT_INSET)
+    ]
+    if any(c is None for c in corners):
+        return None
+    mask = np.zeros(shape[:2], np.uint8)
+    cv2.fillConvexPoly(mask, np.round(np.array(corners)).astype(np.int32), 255)
+    return mask
 
 
 def read_rgb(path: str) -> np.ndarray:
@@ -137,6 +180,17 @@ def analyse_rgb(
     for loc in (chart, bar):
         if loc is not None:
             exclude |= loc.polygon_mask(rgb.shape, grow_px=max(4, rgb.shape[1] // 200))
+    on_support = None
+    if geometry.support is not None:
+        on_support = _support_mask(rgb.shape, geometry, chart, bar, r.px_per_cm)
+        if on_support is None:
+            r.flags.append(
+                "the platform the sherd lies on could not be placed in the photo (chart or bar "
+                "not found, or not where the configuration has them)"
+            )
+        else:
+            exclude |= 255 - on_support
+        object_height_m += geometry.support.height_m
     # segmented in the corrected photo: a colour cast no longer hides a sherd near the table's
     seg = r.corrected if r.corrected is not None else rgb
     sherd = sz.find_sherd(seg, exclude, hint_px)
@@ -170,6 +224,13 @@ def analyse_rgb(
         r.flags.append("sherd not found in the archival photo")
     else:
         r.mask = sherd.mask
+        if (
+            on_support is not None
+            and (cv2.dilate(sherd.mask, np.ones((5, 5), np.uint8)) & ~on_support).any()
+        ):
+            r.flags.append(
+                "the sherd reaches the edge of the platform it lies on: its size may be cut"
+            )
 
     if corr is not None and sherd is not None:
         colour_of(rgb, corr, sherd.mask, r)
