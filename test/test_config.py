@@ -6,7 +6,15 @@ import os
 import pytest
 import yaml
 
-from rascal_tasks.config import ConfigError, config_from_dict, load_config, top_down_reachable
+from rascal_workcell.fixtures import SCALE_HOUSING_MARGIN
+
+from rascal_tasks.config import (
+    ConfigError,
+    config_from_dict,
+    load_config,
+    merged,
+    top_down_reachable,
+)
 
 WORKSPACE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHIPPED = os.path.join(WORKSPACE, "config", "rascal.yaml")
@@ -143,3 +151,84 @@ def test_top_down_reach_matches_the_arm_geometry():
     assert not top_down_reachable(0.55, 0.0, 0.0)  # stretched arm is 0.505 m at the wrist
     assert not top_down_reachable(0.05, 0.0, 0.1)  # over the base
     assert not top_down_reachable(0.40, 0.0, 0.45)  # too high that far out
+
+
+# ------------------------------------------------------------------ the one-station layout
+ONE_STATION = os.path.join(WORKSPACE, "config", "layouts", "one_station.yaml")
+
+
+@pytest.fixture()
+def one_station(shipped):
+    with open(ONE_STATION) as f:
+        return merged(copy.deepcopy(shipped), yaml.safe_load(f))
+
+
+def test_one_station_layout_passes_and_sets_the_sherd_down_once():
+    cfg = load_config(SHIPPED, over=[ONE_STATION])
+    scale, camera = cfg.stations["scale"], cfg.stations["camera"]
+    assert camera.over_scale and not scale.over_scale
+    # the scale sets the sherd down where the camera shoots it
+    assert scale.place_at == camera.place_at
+    assert camera.area.contains(scale.area)
+    assert not load_config(SHIPPED).stations["camera"].over_scale
+
+
+def test_merged_is_what_rosparam_load_does():
+    base = {"a": {"b": 1, "c": [1, 2]}, "d": 2}
+    assert merged(base, {"a": {"c": [3]}, "e": 5}) == {"a": {"b": 1, "c": [3]}, "d": 2, "e": 5}
+    assert base == {"a": {"b": 1, "c": [1, 2]}, "d": 2}  # not changed
+
+
+ONE_STATION_BAD = [
+    (
+        "stations.scale.position",
+        [0.16, -0.10],
+        "stations.scale.position: with stations.camera.over_scale: true the scale's platform "
+        "must lie inside",
+    ),
+    (
+        "stations.camera.scale_bar.position",
+        [0.30, -0.355],
+        "stations.camera.scale_bar: lies on the scale or its housing",
+    ),
+    (
+        "stations.camera.place_at",
+        [0.32, -0.26],
+        "stations.camera.place_at: with stations.camera.over_scale: true the sherd is "
+        "photographed where it is weighed",
+    ),
+    (
+        "stations.scale.taught_place",
+        [0.23, -0.28, 0.0],
+        "stations.scale.taught_place: with stations.camera.over_scale: true the sherd is set "
+        "down at the camera's place",
+    ),
+]
+
+
+@pytest.mark.parametrize("key,value,message", ONE_STATION_BAD, ids=[b[0] for b in ONE_STATION_BAD])
+def test_one_station_layout_errors_name_the_key(one_station, key, value, message):
+    _set(one_station, key, value)
+    with pytest.raises(ConfigError) as e:
+        config_from_dict(one_station)
+    assert message in str(e.value) and "\n" not in str(e.value)
+
+
+def test_one_station_camera_must_follow_the_scale(one_station):
+    st = one_station["stations"]
+    one_station["stations"] = {k: st[k] for k in ["pickup", "camera", "scale", "discard"]}
+    with pytest.raises(
+        ConfigError, match="stations.camera.over_scale: the camera must come right after the scale"
+    ):
+        config_from_dict(one_station)
+
+
+def test_scale_housing_margin_is_the_workcells():
+    import re
+
+    header = os.path.join(
+        WORKSPACE, "src", "rascal_workcell", "include", "rascal_workcell", "Workcell.hpp"
+    )
+    with open(header) as f:
+        value = re.search(r"kScaleHousingMargin = ([0-9.]+);", f.read()).group(1)
+    assert float(value) == SCALE_HOUSING_MARGIN

@@ -17,7 +17,7 @@ from typing import Dict, List, Optional
 import yaml
 
 from rascal_tasks import rig, workflow
-from rascal_tasks.config import config_from_dict
+from rascal_tasks.config import config_from_dict, merged
 from rascal_tasks.catalogue.errors import StatusError
 from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING
 from rascal_tasks.sorting import SherdValues, choose_bin
@@ -74,6 +74,7 @@ class World:
         self.camera_refuses = lambda exposure_ev: False  # and any capture this says
         self.transfer_failures = 0  # captures to fail after their shutter, in the transfer
         self.at_shutter: List[tuple] = []  # where the gripper (x, y, z, yaw) was at each shutter
+        self.in_view_at_shutter: List[list] = []  # names of the sherds lying in the photo
         self.transfer_moves: List[list] = []  # the moves made during each capture's transfer
         # photos written (into `photo_folder`) when set: a grey frame with a white patch of
         # `photo_light` x 255 x 2^EV (clipped at 255), of 1 % of the frame; the EVs asked for
@@ -316,6 +317,10 @@ class _Camera(rig.ArchivalCamera):
             self.w.camera_refusals = max(0, self.w.camera_refusals - 1)
             raise rig.RigError("/archival_camera/capture", "REFUSED", "cannot write " + path)
         self.w.at_shutter.append(self.w.at)
+        view = next(s for s in self.w.config.stations.values() if s.type == "archival_camera")
+        self.w.in_view_at_shutter.append(
+            [s.name for s in self.w.sherds if s is not self.w.held and view.area.has((s.x, s.y))]
+        )
         moved = len(self.w.moves)
         during()  # the transfer: the arm may move
         self.w.transfer_moves.append(self.w.moves[moved:])
@@ -461,10 +466,15 @@ class Recorder:
         return {seq: row.status for seq, row in sorted(self.sherds.items())}
 
 
-def shipped_config():
-    """config/rascal.yaml of this workspace, loaded as `rascal run` loads it."""
+def shipped_config(*over):
+    """config/rascal.yaml of this workspace, loaded as `rascal run` loads it, with the files
+    `over` (relative to the workspace) merged over it."""
     with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
-        return config_from_dict(yaml.safe_load(f))
+        data = yaml.safe_load(f)
+    for layer in over:
+        with open(os.path.join(WORKSPACE, layer)) as f:
+            data = merged(data, yaml.safe_load(f))
+    return config_from_dict(data)
 
 
 def run_batch(config, world: World, recorder: Optional[Recorder] = None):

@@ -149,11 +149,33 @@ def _fail(source: str, key: str, message: str, got=None, show_got=True):
     )
 
 
-def load_config(path: str, workspace: Optional[str] = None) -> Config:
-    """Read and validate a config file. `workspace` defaults to the parent of its folder."""
+def load_config(path: str, workspace: Optional[str] = None, over=()) -> Config:
+    """Read and validate a config file, with the files `over` (a layout's keys, e.g.
+    config/layouts/one_station.yaml) merged over it as `rosparam load` merges them. `workspace`
+    defaults to the parent of its folder."""
+    data = _read_yaml(path)
+    for layer in over:
+        data = merged(data, _read_yaml(layer))
+    if workspace is None:
+        workspace = os.path.dirname(os.path.dirname(os.path.abspath(path)))
+    return config_from_dict(data, source=path, workspace=workspace)
+
+
+def merged(base, over):
+    """`base` with `over` merged in: mappings key by key at every depth, anything else replaced
+    (what `rosparam load` does to the parameter server)."""
+    if not isinstance(base, dict) or not isinstance(over, dict):
+        return over
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = merged(base.get(k), v)
+    return out
+
+
+def _read_yaml(path: str):
     try:
         with open(path, encoding="utf-8") as f:
-            data = yaml.safe_load(f)
+            return yaml.safe_load(f)
     except FileNotFoundError:
         raise ConfigError(
             "%s: file not found; pass the path of config/rascal.yaml" % path
@@ -164,9 +186,6 @@ def load_config(path: str, workspace: Optional[str] = None) -> Config:
         raise ConfigError(
             "%s: not valid YAML%s: %s" % (path, where, getattr(e, "problem", None) or e)
         ) from None
-    if workspace is None:
-        workspace = os.path.dirname(os.path.dirname(os.path.abspath(path)))
-    return config_from_dict(data, source=path, workspace=workspace)
 
 
 def config_from_dict(data, source="config/rascal.yaml", workspace=".") -> Config:

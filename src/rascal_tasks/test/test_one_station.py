@@ -1,0 +1,72 @@
+"""The one-station layout (issue 18, item 4; config/layouts/one_station.yaml): the scale under
+the archival camera, so a sherd is set down once, weighed, photographed where it lies and
+picked up from the scale for the discard box (batch tier, on the in-memory rig)."""
+
+import pytest
+from fake_rig import Recorder, Sherd, World, run_batch, shipped_config
+
+from rascal_tasks import workflow
+from rascal_tasks.layout_bound import sequence
+
+LAYOUT = "config/layouts/one_station.yaml"
+
+
+@pytest.fixture
+def config():
+    return shipped_config(LAYOUT)
+
+
+def test_each_sherd_is_set_down_once_and_photographed_on_the_scale(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, mass=0.031)])
+    outcome, batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
+    assert (rec.sherds[1].mass, rec.sherds[2].mass) == pytest.approx((0.020, 0.031))
+    # each photo shows the sherd in progress, and only it, lying where it was weighed
+    assert world.in_view_at_shutter == [["a"], ["b"]]
+    standby = tuple(config["arm"]["standby"])
+    assert all(at[:2] == pytest.approx(standby) for at in world.at_shutter)
+    # no carry from the scale to the camera: no repick at the scale, no placing at the camera
+    states = set(batch.state_times)
+    assert {"At scale", "At camera", "Repick@camera", "Place@discard"} <= states
+    assert not states & {"Repick@scale", "Translate→camera", "Place@camera"}
+    # the scale never took the sherd lying on it while photographed for one left behind
+    assert not any("stayed on the scale" in n for r in rec.sherds.values() for n in r.notes)
+
+
+def test_the_way_back_during_the_transfer_reaches_the_sherd_on_the_platform(config):
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    outcome, _batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    scale = config.stations["scale"]
+    (over, down) = world.transfer_moves[0]
+    assert over[:2] == pytest.approx(scale.place_at) and down[:2] == pytest.approx(scale.place_at)
+    # fingers at the sherd's grasp height on the platform, not on the table under the camera
+    assert scale.surface_z < down[2] < over[2] < config["arm"]["travel_z"]
+
+
+def test_a_restart_with_a_weighed_sherd_on_the_scale_photographs_it_there(config):
+    scale = config.stations["scale"]
+    lying = Sherd("a", *scale.place_at, station="scale")
+    world = World(config, [lying, Sherd("b", 0.25, 0.30)])
+    rec = Recorder(unfinished=[(1, "weighed", (0.10, 0.22))])
+    rec.sherds[1].mass = 0.020
+    outcome, batch, rec = run_batch(config, world, rec)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
+    assert world.in_view_at_shutter[0] == ["a"]  # shot where it lay, not carried first
+    assert "Repick@scale" not in batch.state_times
+
+
+def test_the_machine_goes_from_the_scale_straight_to_the_camera(config):
+    world = World(config, [])
+    batch = workflow.Batch(config, world.rig(), Recorder(), context="T")
+    camera = batch.plugins[1]
+    assert camera.stays and camera.lies_at is config.stations["scale"]
+    assert [s.name for s in batch.route()] == ["scale", "discard"]
+
+
+def test_the_layouts_sequence_has_one_grasp_and_one_carry_fewer(config):
+    separate = [s.what for s in sequence(shipped_config(), (0.16, 0.25))]
+    one = [s.what for s in sequence(config, (0.16, 0.25))]
+    assert separate.count("descend") == one.count("descend") + 1
+    assert "place at camera" in separate and "place at camera" not in one
+    assert one.count("standby") == 1
