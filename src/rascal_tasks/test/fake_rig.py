@@ -82,6 +82,8 @@ class World:
         self.photo_light = 0.8
         self.exposures: List[float] = []
         self.tare = 0.0
+        self.scale_settle = 0.0  # [s] readings unsteady this long after the load changed
+        self.scale_load, self.scale_changed = 0.0, -1e9
         # sherd name -> the sherd lying under it that its first grasp lifts too (a heap); set
         # down together, the second lands `DOUBLE_APART` from the first
         self.doubles: Dict[str, str] = {}
@@ -297,11 +299,21 @@ class _Scale(rig.Scale):
         self.w.tare = self._load()
 
     def readings(self, since):
-        """A perfect scale: a steady reading of what lies on it now, every 0.1 s of the clock."""
+        """A perfect scale: a steady reading of what lies on it now, every 0.1 s of the clock;
+        with `scale_settle`, readings are unsteady that long after the load was seen to change
+        (at the first look after it)."""
+        load = self._load()
+        if load != self.w.scale_load:
+            self.w.scale_load, self.w.scale_changed = load, self.w.t
         first = math.floor(max(since, self.w.t - 30.0) / 0.1 + 1e-9) + 1
         last = math.floor(self.w.t / 0.1 + 1e-9)
-        mass = self._load() - self.w.tare
-        return [rig.ScaleReading(mass, True, k * 0.1) for k in range(first, last + 1)]
+        settle = self.w.scale_settle
+        steady = self.w.scale_changed + settle
+        mass = load - self.w.tare
+        return [
+            rig.ScaleReading(mass, settle <= 0 or k * 0.1 >= steady, k * 0.1)
+            for k in range(first, last + 1)
+        ]
 
 
 class _Camera(rig.ArchivalCamera):

@@ -13,7 +13,7 @@ import pytest
 
 from rascal_tasks.archival import analyse, analyse_rgb, chart, corrected_path
 from rascal_tasks.archival import colour as col
-from rascal_tasks.archival.analysis import Geometry, Placement
+from rascal_tasks.archival.analysis import Geometry, Placement, Support
 from rascal_tasks.archival.munsell import soil_chart, within_one_chip
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -66,11 +66,14 @@ def synthetic(
     chart_in=True,
     body_srgb=None,
     band_srgb=None,
+    platform_mm=None,
+    platform_deg=0.0,
 ):
     """A photo: table, chart and bar at random places, angles and scales, one octagonal
     sherd; lit by per-channel `gains` (a colour cast) times `brightness`, with noise.
     `body_srgb`: the sherd's colour instead of `chip`'s; `band_srgb`: a painted band along it, a
-    quarter of its width wide. Returns (rgb8, truth)."""
+    quarter of its width wide; `platform_mm`: the sherd lies on a square scale pan this wide (a
+    light pan in an 8 mm dark rim) turned by `platform_deg`. Returns (rgb8, truth)."""
     rng = np.random.default_rng(seed)
     px_per_mm = rng.uniform(4.0, 5.0)
     img = np.empty((H, W, 3), np.uint8)
@@ -95,6 +98,19 @@ def synthetic(
     )
     if body_srgb is not None:
         srgb = body_srgb
+    if platform_mm is not None:
+        for side, grey in ((platform_mm, 60), (platform_mm - 16, 205)):
+            a = np.radians(platform_deg)
+            u, v = np.array([np.cos(a), np.sin(a)]), np.array([-np.sin(a), np.cos(a)])
+            half = side * px_per_mm / 2
+            square = np.array(
+                [
+                    cells[order[2]] + half * (i * u + j * v)
+                    for i, j in ((-1, -1), (1, -1), (1, 1), (-1, 1))
+                ],
+                np.int32,
+            )
+            cv2.fillConvexPoly(img, square, (grey, grey, grey + 2))
     cv2.fillPoly(img, [poly], tuple(int(v) for v in srgb))
     if band_srgb is not None:
         band = np.zeros(img.shape[:2], np.uint8)
@@ -250,6 +266,50 @@ def test_a_plain_sherd_near_the_tables_colour_is_looked_for_where_the_layout_put
     untrusted = Geometry(placement=Placement(moved, bar_xy, place_xy))
     r = analyse_rgb(rgb, geometry=untrusted, wrist_size_mm=wrist)
     assert r.length_mm is None and "sherd not found in the archival photo" in r.flags
+
+
+def _table_frame(turn, truth):
+    """A camera turned by `turn` over the table: photo px -> table (x, y) in m."""
+    turned = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    origin, px_per_m = np.array([700.0, 500.0]), truth["px_per_cm"] * 100.0
+
+    def on_table(px):  # photo = px_per_m * turned @ (x, -y) + origin
+        x, minus_y = turned.T @ (np.asarray(px, float) - origin) / px_per_m
+        return (x, -minus_y)
+
+    return on_table
+
+
+@pytest.mark.parametrize("seed", [51, 52, 53])
+def test_a_sherd_on_the_scale_pan_under_the_camera_is_measured_on_the_pan(seed):
+    """The one-station layout: the sherd lies on the scale's pan, which stands out from the
+    table far more than the sherd from the pan. Told what it lies on (the platform's outline on
+    the table, placed in the photo through the chart and the bar), the analysis looks only
+    there and measures the sherd; the platform's height above the targets' plane enters the
+    parallax."""
+    turn = np.random.default_rng(seed).uniform(-np.pi, np.pi)  # the camera's, over the table
+    # the pan lies along the table's axes: in the photo it is turned as the camera is
+    rgb, truth = synthetic(seed, platform_mm=110.0, platform_deg=np.degrees(turn))
+    on_table = _table_frame(turn, truth)
+    chart_xy, bar_xy = on_table(truth["chart"].mean(axis=0)), on_table(truth["bar"].mean(axis=0))
+    centre, side = on_table(truth["centre_px"]), 0.110
+    placement = Placement(chart_xy, bar_xy, centre)
+    bare = analyse_rgb(rgb, geometry=Geometry(placement=placement))
+    assert bare.length_mm is None or abs(bare.length_mm - truth["length_mm"]) > 10.0  # the pan
+    flat = Geometry(placement=placement, support=Support(centre, (side, side), 0.0))
+    r = analyse_rgb(rgb, geometry=flat)
+    assert r.length_mm == pytest.approx(truth["length_mm"], abs=1.5), r.flags
+    assert r.width_mm == pytest.approx(truth["width_mm"], abs=1.5), r.flags
+    raised = Geometry(
+        camera_height_m=0.55, placement=placement, support=Support(centre, (side, side), 0.025)
+    )
+    r2 = analyse_rgb(rgb, geometry=raised)
+    assert r2.length_mm == pytest.approx(r.length_mm * 0.525 / 0.55, rel=1e-6)
+    # chart and bar not where the layout has them: the platform is not placed; said, not guessed
+    moved = tuple(np.add(bar_xy, 1.3 * np.subtract(chart_xy, bar_xy)))
+    lost = Geometry(placement=Placement(moved, bar_xy, centre), support=flat.support)
+    r3 = analyse_rgb(rgb, geometry=lost)
+    assert any("platform the sherd lies on could not be placed" in f for f in r3.flags)
 
 
 def test_blank_image_gives_flags_not_exceptions(tmp_path):

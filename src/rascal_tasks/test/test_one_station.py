@@ -70,3 +70,23 @@ def test_the_layouts_sequence_has_one_grasp_and_one_carry_fewer(config):
     assert separate.count("descend") == one.count("descend") + 1
     assert "place at camera" in separate and "place at camera" not in one
     assert one.count("standby") == 1
+
+
+def test_a_sherd_left_on_the_scale_is_taken_to_the_mat_before_the_batch_ends(config):
+    """With the camera over the scale no later station watches the empty pan with the arm
+    free: the pan is looked at again when the mat is found empty, and what stayed on it is
+    taken back and recorded as its own sherd, not left on the scale unsaid."""
+    big = Sherd("big", 0.14, 0.24, length=0.06, width=0.05, thickness=0.009, mass=0.030)
+    rider = Sherd("rider", 0.14, 0.24, length=0.04, width=0.03, mass=0.015)
+    world = World(config, [big, rider])
+    world.doubles = {"big": "rider"}  # the first grasp of `big` lifts `rider` too
+    world.scale_settle = 1.5  # the pan not steady yet when the arm is at the discard box
+    outcome, _batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
+    assert rec.sherds[2].mass == pytest.approx(0.015)  # weighed on its own, later
+    assert {s.station for s in world.sherds} == {"discard"}
+    assert any(n.startswith("cleared: ") for n in rec.sherds[1].notes)
+    # the first row weighed both; it was photographed (done) before the pan was seen: its own
+    # mass by difference is said on it
+    assert rec.sherds[1].mass == pytest.approx(0.045)
+    assert any("its own mass by difference 30.0 g" in n for n in rec.sherds[1].notes)

@@ -30,7 +30,12 @@ class Translate(BatchState):
 
     def run(self):
         b = self.batch
-        st = b.plugins[self.index].target(b.sherd)
+        plugin = b.plugins[self.index]
+        # the station may get ready for it meanwhile (a scale whose pan has stood empty since
+        # the last sherd left it is tared now: with the camera over the scale no later
+        # station's work gave it the time)
+        plugin.while_away(arm_free=False)
+        st = plugin.target(b.sherd)
         b.move_down(*st.place_at, b.travel_z(), station_yaw(b.config, st, b.sherd.grasp_yaw))
         if not b.rig.gripper.holding():
             b.sherd.dropped("while carrying to %s" % st.name)

@@ -73,10 +73,13 @@ class StationPlugin:
         """Called with the sherd (a SherdRecord) in the gripper above the station (e.g. tare
         the scale)."""
 
-    def while_away(self) -> None:
-        """Called while the arm works at a later station, the sherd gone from this one: a
-        station may start here, without waiting, what its next sherd needs (the scale tares its
-        empty pan)."""
+    def while_away(self, arm_free: bool = True) -> bool:
+        """Called while the arm works at a later station, the sherd gone from this one, or
+        carries the next sherd here, or surveys the pickup mat: a station may start here,
+        without waiting, what its next sherd needs (the scale tares its empty pan).
+        `arm_free`: nothing in the gripper (the station may use the arm). True when it put
+        something on the pickup mat (a sherd left on the scale)."""
+        return False
 
     def reach_back(self, sherd) -> None:
         """The arm back at `sherd`, lying here, the fingers open around it, ready to pick it up
@@ -131,6 +134,7 @@ class ScaleStation(StationPlugin):
     def __init__(self, station, batch):
         super().__init__(station, batch)
         self._tared_for = None  # seq of the sherd the scale was tared (and checked) for
+        self._last = None  # the SherdRecord placed on the scale last (it may be done since)
         self._before_tare = 0.0  # kg, what the settled empty pan read before the last tare
         self._early_tare = None  # (clock time, empty reading before it) of while_away's tare
 
@@ -186,25 +190,29 @@ class ScaleStation(StationPlugin):
             self.batch.rig.scale.readings(since), cfg["stable_window"], cfg["readability"]
         )
 
-    def while_away(self):
-        """Tares the empty pan while the arm is at the next stations (it takes a whole stable
-        window after the tare to check it: that wait was spent standing above the scale with
-        the next sherd). Only a pan that has read steady for a whole window is tared; otherwise
-        the next sherd's tare is done above the scale as before."""
+    def while_away(self, arm_free=True):
+        """Tares the empty pan while the arm is at the next stations, or carries the next
+        sherd here (it takes a whole stable window after the tare to check it: that wait was
+        spent standing above the scale with the next sherd). Only a pan that has read steady
+        for a whole window is tared; otherwise the next sherd's tare is done above the scale as
+        before. A sherd left on the pan is taken off it only with the arm free."""
         if self._early_tare is not None:
-            return
+            return False
         b, cfg = self.batch, self._cfg()
         empty = self._settled_now(b.rig.clock.now() - cfg["stable_window"] - 1.0)
         if empty is None:
-            return
-        if empty.mass >= MIN_SHERD_MASS and self._left_on_pan(empty.mass):
-            return  # the next sherd's tare is done above the scale
+            return False
+        if empty.mass >= MIN_SHERD_MASS:
+            # taken to the mat (the next sherd's tare is done above the scale), or, with the
+            # arm busy, left for a call with the arm free (the survey before the batch ends)
+            return arm_free and self._left_on_pan(empty.mass)
         try:
             b.rig.scale.tare()
         except RigError as e:  # tared again, and said, when the next sherd is above the scale
             b.log("early tare of the scale failed: %s" % e)
-            return
+            return False
         self._early_tare = (b.rig.clock.now(), empty.mass)
+        return False
 
     def _left_on_pan(self, kg: float) -> bool:
         """`kg` lies on the pan, settled, since the sherd weighed here was lifted off it: a
@@ -213,7 +221,7 @@ class ScaleStation(StationPlugin):
         photographed, else noted). The other is taken back to the pickup mat, to be recorded
         as its own sherd (station_states.clear_to_mat). True when the pan was cleared."""
         b = self.batch
-        s = b.sherd
+        s = self._last  # the sherd in progress, or done since (the camera over the scale)
         if s is not None and s.mass is not None and self._tared_for == s.seq:
             own = s.mass - kg
             text = (
@@ -286,7 +294,7 @@ class ScaleStation(StationPlugin):
 
     def _tared(self, sherd):
         """The pan is tared and checked for `sherd`."""
-        self._tared_for = sherd.seq
+        self._tared_for, self._last = sherd.seq, sherd
         if self._before_tare >= MIN_SHERD_MASS:
             # a sherd the wrist camera did not see there (or a zero that moved): the tare takes
             # it away, but the archaeologist is told, on this row

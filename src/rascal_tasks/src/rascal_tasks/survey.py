@@ -150,6 +150,10 @@ class Survey(BatchState):
         if not found:
             if lay_flat(b):  # a sherd standing on its edge, pushed over: it may be picked now
                 return self.run()
+            # a sherd left on a station (one that rode onto the scale on the last sherd, where
+            # no later station gave the pan time to settle empty) is taken to the mat first
+            if any(p.while_away() for p in b.plugins if not p.stays):
+                return self.run()
             b.empty_surveys += 1
             if b.empty_surveys >= b.config["recovery"]["max_empty_surveys"]:
                 if b.renumber is not None:  # its number must not stay unfinished
