@@ -145,6 +145,16 @@ def call(rig, code):
     return yaml.safe_load(rig.run(["/usr/bin/python3", "-c", code]).stdout)
 
 
+def picked_sherd(truth, row) -> str:
+    """The scenario sherd (a name of `ground_truth`'s answer taken before the batch) that the
+    catalogue row was picked up as: the nearest to where the row says it was picked."""
+    return min(
+        truth,
+        key=lambda n: (truth[n][0] - row["pickup_x_m"]) ** 2
+        + (truth[n][1] - row["pickup_y_m"]) ** 2,
+    )
+
+
 def ground_truth(rig):
     """name -> [x, y, mass kg] from the simulator's test-only service."""
     return call(

@@ -17,6 +17,7 @@ from rig_helpers import (
     ground_truth,
     inject,
     joint_positions,
+    picked_sherd,
     rows,
     run_batch,
     run_until_weighed,
@@ -39,11 +40,7 @@ def test_three_sherd_batch_records_every_sherd(rig_factory, ros_master, db, tmp_
     # about 21 g) and its mass matches that sherd's within 0.2 g.
     names = set()
     for r in recorded:
-        name = min(
-            truth,
-            key=lambda n: (truth[n][0] - r["pickup_x_m"]) ** 2
-            + (truth[n][1] - r["pickup_y_m"]) ** 2,
-        )
+        name = picked_sherd(truth, r)
         assert abs(r["mass_g"] - truth[name][2] * 1000) < 0.2, (r["seq"], name, r["mass_g"])
         names.add(name)
         # the wall, not the height as it lies (the curved shells stand 1-3 mm higher than their

@@ -5,7 +5,7 @@ wrong mass is committed, no sherd is taken for dropped, and every sherd is recor
 Run alone with `pytest -m faults`."""
 
 import pytest
-from rig_helpers import SMALL, ground_truth, inject, rows, run_batch, start_rig
+from rig_helpers import SMALL, ground_truth, inject, picked_sherd, rows, run_batch, start_rig
 
 pytestmark = [pytest.mark.faults, pytest.mark.timeout(900)]
 
@@ -36,11 +36,7 @@ def _check_batch(recorded, truth):
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     names = set()
     for r in recorded:
-        name = min(
-            truth,
-            key=lambda n: (truth[n][0] - r["pickup_x_m"]) ** 2
-            + (truth[n][1] - r["pickup_y_m"]) ** 2,
-        )
+        name = picked_sherd(truth, r)
         names.add(name)
         if r["mass_g"] is not None:
             assert abs(r["mass_g"] - truth[name][2] * 1000) < 0.2, (name, _summary(recorded))

@@ -7,7 +7,7 @@ analysis finds it on the scale's pan. Asserts outcomes, never timings."""
 import os
 
 import pytest
-from rig_helpers import ground_truth, rows, run_batch
+from rig_helpers import ground_truth, picked_sherd, rows, run_batch
 
 from rascal_tasks import exit_codes
 
@@ -33,11 +33,7 @@ def test_one_station_batch_weighs_and_photographs_each_sherd_where_it_lies(
     assert "Place@camera" not in out and "Repick@scale" not in out, out[-2000:]
     names = set()
     for r in recorded:
-        name = min(
-            truth,
-            key=lambda n: (truth[n][0] - r["pickup_x_m"]) ** 2
-            + (truth[n][1] - r["pickup_y_m"]) ** 2,
-        )
+        name = picked_sherd(truth, r)
         names.add(name)
         assert abs(r["mass_g"] - truth[name][2] * 1000) < 0.2, (r["seq"], name, r["mass_g"])
         # photographed on the pan: found there and measured, its colour read

@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from rascal_tasks import layout_bound as lb
-from rascal_tasks.config import config_from_dict
+from rascal_tasks.config import config_from_dict, merged
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
@@ -67,3 +67,28 @@ def test_a_wait_that_overlaps_the_next_move_costs_only_what_the_move_leaves_of_i
     assert serial(move / 2) == 0.0
     last = [lb.Step("a", (0.0, 0, 0), serial_wait=1.0, overlaps_next=True)]
     assert lb.timed(last, ik1, [0.0] * 6)[2] == 1.0  # no move after it: all of it
+
+
+def test_a_wait_run_on_during_the_next_moves_is_waited_only_past_them():
+    def ik1(x, y, z, seed):  # the waist alone turns to x (rad)
+        return [x, 0.0, 0.0, 0.0, 0.0, 0.0]
+
+    def waits(wait):  # the scale settling while the arm goes up and to standby (2 moves)
+        steps = [
+            lb.Step("settles", (0.0, 0, 0), wait=wait, wait_during=2),
+            lb.Step("up", (0.5, 0, 0)),
+            lb.Step("standby", (1.0, 0, 0), wait=0.2),
+        ]
+        return lb.timed(steps, ik1, [0.0] * 6)[1]
+
+    moves = 2 * lb.move_time([0.0] * 6, [0.5] + [0.0] * 5)
+    assert waits(moves + 0.7) == pytest.approx(0.7 + 0.2)
+    assert waits(moves / 2) == pytest.approx(0.2)
+
+
+def test_one_station_bound_is_below_the_separate_stations(data):
+    with open(os.path.join(WORKSPACE, "config", "layouts", "one_station.yaml")) as f:
+        one = config_from_dict(merged(data, yaml.safe_load(f)))
+    separate = lb.bound_of(config_from_dict(data), ik)
+    together = lb.bound_of(one, ik)
+    assert together["bound"] < separate["bound"] and together["motion"] < separate["motion"]

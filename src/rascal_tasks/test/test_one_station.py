@@ -25,6 +25,14 @@ def test_each_sherd_is_set_down_once_and_photographed_on_the_scale(config):
     assert world.in_view_at_shutter == [["a"], ["b"]]
     standby = tuple(config["arm"]["standby"])
     assert all(at[:2] == pytest.approx(standby) for at in world.at_shutter)
+    # set down, straight up and out of view: the scale settles with the arm at standby (no
+    # hover over it as when a repick follows the weighing)
+    scale, travel = config.stations["scale"], config["arm"]["travel_z"]
+    k = next(i for i, m in enumerate(world.moves) if m[:2] == pytest.approx(standby))
+    over, place, up = world.moves[k - 3 : k]
+    assert over[:2] == pytest.approx(scale.place_at) and over[2] == pytest.approx(travel)
+    assert place[:2] == pytest.approx(scale.place_at) and place[2] < travel and place[4]
+    assert up[:2] == pytest.approx(scale.place_at) and up[2] == pytest.approx(travel) and up[4]
     # no carry from the scale to the camera: no repick at the scale, no placing at the camera
     states = set(batch.state_times)
     assert {"At scale", "At camera", "Repick@camera", "Place@discard"} <= states

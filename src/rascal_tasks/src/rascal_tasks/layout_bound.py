@@ -15,6 +15,10 @@ simulator's models (the scale's settling, the camera's shutter and transfer). Tw
 - `bound`: the same moves with only what cannot overlap arm motion (the loaded scale settling
   while the arm hovers, the shutter): no planner margin, no transfer wait.
 
+With the camera over the scale (`over_scale`, the one-station layout) the sherd is set down
+once: the scale settles while the arm lifts and goes to standby, the shutter, the way back
+during the transfer, the grasp for the discard box.
+
 Pickup spots are averaged over a grid of the pickup area; the lawnmower survey is shared by the
 batch's sherds. No ROS here: `rosrun rascal_tasks layout_bound` (scripts/) gives `bound_of` the
 arm controller's IK.
@@ -56,6 +60,7 @@ class Step:
     wait: float = 0.0  # [s] after arriving (gripper stroke, station) in the bound
     serial_wait: float = 0.0  # [s] more as the workflow runs today: in series, but for...
     overlaps_next: bool = False  # ...the next move, made meanwhile
+    wait_during: int = 0  # `wait` runs on during this many next moves: only its excess counts
 
 
 def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> List[Step]:
@@ -82,16 +87,19 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
             x, y = st.place_at
             steps.append(Step("over discard", (x, y, travel), wait=margin_stroke))  # let go
             continue
-        if not st.over_scale:  # over the scale it is shot where it lies, from the hover
+        if not st.over_scale:  # over the scale (one station) it is shot where it lies
             x, y = st.place_at
             z = st.surface_z + GRASP_HEIGHT + arm["place_clearance"]
             steps.append(Step("over " + name, (x, y, travel)))  # a scale tared meanwhile
             steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke))
         if st.type == "scale":
             settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
-            steps.append(Step("hover", (x, y, z + approach), wait=settle))  # while it settles
             if after is not None and cfg.stations[after].over_scale:
+                # it settles while the arm goes up and out of the camera's view (make_way)
+                steps.append(Step("scale settles", (x, y, z), wait=settle, wait_during=2))
+                steps.append(Step("lift", (x, y, travel)))
                 continue  # the camera over it takes it from here
+            steps.append(Step("hover", (x, y, z + approach), wait=settle))  # while it settles
         elif st.type == "archival_camera":
             if not st.over_scale:
                 steps.append(Step("lift", (x, y, travel)))
@@ -133,12 +141,20 @@ def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, 
     """(motion, bound waits, serial waits, last joints) of `steps` from the joints `start`."""
     q, motion, waits, serial = start, 0.0, 0.0, 0.0
     overlapping = 0.0  # a serial wait the next move is made during
+    running, moves_left = 0.0, 0  # a wait the next moves are made during (Step.wait_during)
     for s in steps:
         q1 = ik(*s.pose, q)
         move = move_time(q, q1)
         motion += move
         serial += max(0.0, overlapping - move)
-        waits += s.wait
+        if moves_left:
+            running, moves_left = max(0.0, running - move), moves_left - 1
+            if not moves_left:
+                waits += running  # what is left of it is waited here
+        if s.wait_during:
+            running, moves_left = s.wait, s.wait_during
+        else:
+            waits += s.wait
         overlapping = s.serial_wait if s.overlaps_next else 0.0
         serial += 0.0 if s.overlaps_next else s.serial_wait
         q = q1

@@ -66,6 +66,14 @@ class Place(BatchState):
         with b.phase("grasping"):
             # picked up again as wide as the fingers held it (a chord longer than its width)
             s.width = release(b, s.width)
+        after = b.plugins[self.index + 1] if self.index + 1 < len(b.plugins) else None
+        if after is not None and after.stays:
+            # the next station works on it here (the camera over the scale): straight up, and
+            # out of its way while this one measures (the scale settles meanwhile)
+            b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
+            s.placed(st, yaw)
+            after.make_way(s)
+            return "placed"
         if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)
             hover = st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
             b.move_down(*st.place_at, hover, yaw, linear=True)

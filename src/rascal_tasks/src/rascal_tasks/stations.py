@@ -81,6 +81,11 @@ class StationPlugin:
         something on the pickup mat (a sherd left on the scale)."""
         return False
 
+    def make_way(self, sherd) -> None:
+        """For a station that `stays`: the sherd was just set down by the station before, the
+        arm above it at travel height; it may go where this station needs it while the one
+        before measures (the camera's standby)."""
+
     def reach_back(self, sherd) -> None:
         """The arm back at `sherd`, lying here, the fingers open around it, ready to pick it up
         (manipulation.reach): for a plug-in to run while it waits with the arm away."""
@@ -390,11 +395,14 @@ class ArchivalCameraStation(StationPlugin):
         super().__init__(station, batch)
         self.exposure = Exposure()
         self.at_sherd = False  # the arm reached back for the sherd during a capture
+        self._made_way = False  # the arm went to standby as the sherd was set down (make_way)
 
     def after_place(self, sherd):
         b = self.batch
-        # placing lifted the arm to travel height; on the scale it waits just above the sherd
-        self.at_sherd = self.stays
+        # placing lifted the arm to travel height, or (on the scale) took it to standby; after
+        # a restart it may be anywhere above the sherd on the scale: straight up first
+        self.at_sherd = self.stays and not self._made_way
+        self._made_way = False
         with b.phase("data_collection"):
             capture = self._capture(sherd, sherd.spool_path())
             if capture is None:
@@ -435,6 +443,12 @@ class ArchivalCameraStation(StationPlugin):
                 b.rig.clock.sleep(1.0)
         self._standby(sherd)
         return None
+
+    def make_way(self, sherd):
+        """Out of view while the scale under the camera settles: the shutter needs no move."""
+        self.at_sherd = False
+        self._standby(sherd)
+        self._made_way = True
 
     def _reach_back(self, sherd):
         self.at_sherd = True
