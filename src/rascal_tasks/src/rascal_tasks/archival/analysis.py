@@ -309,7 +309,8 @@ def locate_bar(rgb, feats, geometry: Geometry, chart, r: ArchivalResult):
     """The bar by features (the seed's method), then refined by its outline: the one
     black-and-white rectangle of its proportions near where the features put it (sub-pixel
     edges over its whole length, where a few feature points leave ~0.5 % of scale error). With
-    too few features, the outline alone, searched over the whole photo (chart left out). A bar
+    too few features, the outline alone, searched over the whole photo (chart left out). Where
+    features and outline disagree, the one nearer the chart's scale (else the features). A bar
     whose scale disagrees with the chart's by more than BAR_CHART_AGREEMENT is flagged."""
     why = []
     feat = None
@@ -332,6 +333,11 @@ def locate_bar(rgb, feats, geometry: Geometry, chart, r: ArchivalResult):
     if feat is not None:
         if outline is None or abs(_scale(outline, geometry) / _scale(feat, geometry) - 1) > 0.03:
             bar = feat
+            if outline is not None and chart is not None:
+                # two readings of the bar that disagree: the one the chart bears out (a
+                # darker exposure's features fitted the bar 9 % long, its outline exactly)
+                ref = chart_px_per_cm(chart, geometry.chart)
+                bar = min((feat, outline), key=lambda b: abs(_scale(b, geometry) / ref - 1))
     if bar is None:
         r.flags.append("no size: %s" % "; ".join(why))
         return None
