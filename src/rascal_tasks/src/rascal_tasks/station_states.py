@@ -181,7 +181,7 @@ class PutBack(BatchState):
     def run(self):
         b = self.batch
         s = b.sherd
-        st = b.config.stations[b.station_names[self.index]]
+        st = b.plugins[self.index].lies_at
         if not repick(b, self.index):
             return "lost"  # recorded lost (the two lie at the station, for a person)
         spots = [free_spot(b.pickup.area, b.seen)]
@@ -195,7 +195,8 @@ class PutBack(BatchState):
                     "the second of two sherds lifted as one stays on the %s" % st.name, st
                 )
             spots.append(self._spot_beside(spots[0]))
-            self._set_down(*spots[1])
+            o = seen[0]  # set down as it was grasped, not as the first one was
+            set_down_on_mat(b, *spots[1], o.grasp_yaw, o.grasp_z - st.surface_z, o.width)
         else:
             # both came in the one grasp and were set down together: if one still lies on the
             # other, the top one is taken apart (set down together they may not fall apart,
