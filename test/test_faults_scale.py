@@ -74,5 +74,10 @@ def test_premature_tare_is_redone_and_the_mass_is_right(rig, db):
     assert _check_batch(recorded, truth) == [], _summary(recorded)  # every mass taken, right
     first = recorded[0]
     notes = first["notes"] or ""
-    assert "tare_failed: attempt 1: the empty platform reads -3" in notes, _summary(recorded)
-    assert "tare_failed: attempt 2" not in notes, _summary(recorded)
+    # the faulty tare is the first one made: above the scale (its check fails, said on the row)
+    # or, as the sherd is carried there, while away (not holding when it arrives: tared again)
+    redone = "tare_failed: attempt 1: the empty platform reads -3" in notes or (
+        "tare made while away" in notes + out and "tared again" in notes + out
+    )
+    assert redone, _summary(recorded) + out[-2000:]
+    assert "tare_failed: attempt 2" not in notes, _summary(recorded)  # redone once, and it took

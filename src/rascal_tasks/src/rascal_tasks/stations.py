@@ -252,15 +252,28 @@ class ScaleStation(StationPlugin):
         )
         return True
 
-    def _early_tare_holds(self) -> bool:
+    def _early_tare_holds(self, sherd) -> bool:
         """Whether while_away's tare (if any) still holds: since it, the pan has read zero
         within the readability for a whole window. Used once: a sherd placed after it needs a
-        tare of its own."""
+        tare of its own. One that settled off zero is said on `sherd`'s row (a tare that caught
+        the pan swinging); one not yet steady is only logged (the arm came back soon)."""
         early, self._early_tare = self._early_tare, None
         if early is None:
             return False
         zero = self._settled_now(early[0])
-        if zero is None or abs(zero.mass) > self._cfg()["readability"] + 1e-9:
+        if zero is None:
+            self.batch.log(
+                "sherd %d: the pan not steady for a window since the tare made while away: "
+                "tared again above the scale" % sherd.seq
+            )
+            return False
+        if abs(zero.mass) > self._cfg()["readability"] + 1e-9:
+            self.batch.event(
+                sherd,
+                "tare_failed",
+                "the tare made while away: the empty platform reads %.1f g after it; tared "
+                "again above the scale" % (zero.mass * 1000),
+            )
             return False
         self._before_tare = early[1]
         return True
@@ -284,7 +297,7 @@ class ScaleStation(StationPlugin):
     def before_place(self, sherd):
         self._tared_for = None
         b = self.batch
-        if self._early_tare_holds():
+        if self._early_tare_holds(sherd):
             self._tared(sherd)
             return
         with b.phase("data_collection"):
