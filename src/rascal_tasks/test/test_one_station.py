@@ -98,3 +98,24 @@ def test_a_sherd_left_on_the_scale_is_taken_to_the_mat_before_the_batch_ends(con
     # mass by difference is said on it
     assert rec.sherds[1].mass == pytest.approx(0.045)
     assert any("its own mass by difference 30.0 g" in n for n in rec.sherds[1].notes)
+
+
+def test_a_sherd_recorded_lost_on_the_scale_is_left_there(config):
+    """What lies on the pan after the scale's last sherd was recorded lost there is most likely
+    that sherd (its grasps failed): it is left for a person, not taken to the mat to be picked
+    and recorded a second time. Any other sherd left on the pan is taken to the mat."""
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    outcome, batch, rec = run_batch(config, world)
+    assert outcome == "finished"
+    scale = next(p for p in batch.plugins if p.station.name == "scale")
+    left = Sherd("left", 0.0, 0.0, mass=0.02)
+    world.sherds.append(left)
+    world.put(left, *config.stations["scale"].place_at)
+    world.t += 10.0  # settled on the pan for longer than a stable window
+    scale._early_tare = None
+    scale._last.status = "lost"
+    assert scale.while_away(arm_free=True) is False
+    assert left.station == "scale"
+    scale._last.status = "done"
+    assert scale.while_away(arm_free=True) is True
+    assert left.station == "pickup"

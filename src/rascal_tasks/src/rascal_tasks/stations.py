@@ -227,6 +227,14 @@ class ScaleStation(StationPlugin):
         as its own sherd (station_states.clear_to_mat). True when the pan was cleared."""
         b = self.batch
         s = self._last  # the sherd in progress, or done since (the camera over the scale)
+        if s is not None and s.status == "lost":
+            # most likely that sherd itself (the grasps on it failed here): taken to the mat,
+            # it would be picked and recorded a second time, as a new row
+            b.log(
+                "%.1f g lies on the scale after sherd %s was recorded lost there: left for a "
+                "person" % (kg * 1000, s.seq)
+            )
+            return False
         if s is not None and s.mass is not None and self._tared_for == s.seq:
             own = s.mass - kg
             text = (
