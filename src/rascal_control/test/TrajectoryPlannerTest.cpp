@@ -168,3 +168,85 @@ TEST(TrajectoryPlanner, LinearMoveToAnUnreachablePointFails) {
   EXPECT_EQ(r.code, PlanCode::Unreachable);
   EXPECT_NE(r.message.find("waypoint"), std::string::npos) << r.message;
 }
+
+namespace {
+
+KDL::Frame topDown(double x, double y, double z, double yaw) {
+  return KDL::Frame(KDL::Rotation::RPY(0.0, M_PI / 2, yaw), KDL::Vector(x, y, z));
+}
+
+// A sherd's way from the pickup mat to the scale: lift, carry at travel height, descend.
+std::vector<ChainStep> liftCarryDescend() {
+  return {{topDown(0.15, 0.25, 0.10, 0.3), true},
+          {topDown(0.25, -0.25, 0.10, 0.0), false},
+          {topDown(0.25, -0.25, 0.04, 0.0), true}};
+}
+
+}  // namespace
+
+TEST(TrajectoryPlanner, ChainWithoutBlendingStopsAtEveryCorner) {
+  IkSolver ik(testModel());
+  TrajectoryPlanner planner(testModel(), ik, nullptr);
+  const IkResult start = ik.solve(topDown(0.15, 0.25, 0.02, 0.3), JointVector{});
+  ASSERT_TRUE(start.ok()) << start.message;
+  const PlanResult r = planner.planChain(start.joints, liftCarryDescend(), 0.0, 1.0);
+  ASSERT_TRUE(r.ok()) << r.message;
+  ASSERT_TRUE(r.trajectory.chained());
+  double sum = 0.0;
+  for (const Trajectory& m : r.trajectory.moves()) sum += m.duration();
+  EXPECT_NEAR(r.trajectory.duration(), sum, 1e-9);
+  // at rest at each corner, and there
+  double t = 0.0;
+  for (std::size_t i = 0; i + 1 < r.trajectory.moves().size(); ++i) {
+    t += r.trajectory.moves()[i].duration();
+    const Trajectory::Sample s = r.trajectory.sample(t);
+    for (std::size_t j = 0; j < kArmJoints; ++j) {
+      EXPECT_NEAR(s.qd[j], 0.0, 1e-6);
+      EXPECT_NEAR(s.q[j], r.trajectory.moves()[i].goal()[j], 1e-9);
+    }
+  }
+}
+
+TEST(TrajectoryPlanner, BlendedChainIsFasterWithinTheLimitsAndAboveTheFloor) {
+  IkSolver ik(testModel());
+  TrajectoryPlanner planner(testModel(), ik, nullptr);
+  const IkResult start = ik.solve(topDown(0.15, 0.25, 0.02, 0.3), JointVector{});
+  ASSERT_TRUE(start.ok()) << start.message;
+  const PlanResult stop = planner.planChain(start.joints, liftCarryDescend(), 0.0, 1.0);
+  const double floor = 0.06;
+  const PlanResult r = planner.planChain(start.joints, liftCarryDescend(), floor, 1.0);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_LT(r.trajectory.duration(), stop.trajectory.duration() - 0.1);
+  double velocity, acceleration, fd_velocity;
+  limitRatios(r.trajectory, 1.0, velocity, acceleration, fd_velocity);
+  EXPECT_LE(velocity, 1.0 + 1e-6);
+  EXPECT_LE(acceleration, 1.0 + 1e-6);
+  EXPECT_LE(fd_velocity, 1.0 + 1e-3);
+  // same start and end; where the gripper is below the floor it is on a move's own path: the
+  // lift and the descent straight above their points
+  for (std::size_t j = 0; j < kArmJoints; ++j) {
+    EXPECT_NEAR(r.trajectory.sample(0.0).q[j], start.joints[j], 1e-9);
+    EXPECT_NEAR(r.trajectory.sample(r.trajectory.duration()).q[j], stop.trajectory.goal()[j], 1e-9);
+  }
+  for (double t = 0.0; t <= r.trajectory.duration(); t += 0.005) {
+    const KDL::Vector p = testModel().forward(r.trajectory.sample(t).q).p;
+    if (p.z() < floor - 1e-6) {
+      const bool near_lift = std::hypot(p.x() - 0.15, p.y() - 0.25) < 0.001;
+      const bool near_descent = std::hypot(p.x() - 0.25, p.y() + 0.25) < 0.001;
+      EXPECT_TRUE(near_lift || near_descent) << "at t = " << t << " the gripper is at (" << p.x()
+                                             << ", " << p.y() << ", " << p.z() << ")";
+    }
+  }
+}
+
+TEST(TrajectoryPlanner, ChainNamesTheStepThatFails) {
+  IkSolver ik(testModel());
+  TrajectoryPlanner planner(testModel(), ik, nullptr);
+  const IkResult start = ik.solve(topDown(0.15, 0.25, 0.02, 0.3), JointVector{});
+  ASSERT_TRUE(start.ok());
+  std::vector<ChainStep> steps = liftCarryDescend();
+  steps[1].goal = topDown(2.0, 0.0, 0.10, 0.0);  // out of reach
+  const PlanResult r = planner.planChain(start.joints, steps, 0.07, 1.0);
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.message.find("move 2 of 3"), std::string::npos) << r.message;
+}

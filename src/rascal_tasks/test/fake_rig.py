@@ -64,6 +64,7 @@ class World:
         self.at = (0.0, 0.0, 0.3, 0.0)  # ee_gripper_link x, y, z, yaw
         self.t = 0.0
         self.moves: List[tuple] = []
+        self.chains: List[list] = []  # the steps of each move_through (each also in `moves`)
         self.named: List[str] = []  # named poses gone to (park: "sleep")
         self.refuse = lambda x, y, z, yaw, linear: None
         self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
@@ -148,6 +149,10 @@ class _Arm(rig.Arm):
         self.w.moves.append((x, y, z, yaw, linear))
         self.w.t += 1.0
         return 1.0
+
+    def move_through(self, steps, blend_above):
+        self.w.chains.append(list(steps))  # one after the other, as the base class does
+        return super().move_through(steps, blend_above)
 
     def go(self, named):
         self.w.named.append(named)

@@ -92,3 +92,17 @@ def test_one_station_bound_is_below_the_separate_stations(data):
     separate = lb.bound_of(config_from_dict(data), ik)
     together = lb.bound_of(one, ik)
     assert together["bound"] < separate["bound"] and together["motion"] < separate["motion"]
+
+
+def test_moves_made_as_one_motion_are_timed_as_one_move(data):
+    def ik1(x, y, z, seed):  # the waist alone turns to x (rad)
+        return [x, 0.0, 0.0, 0.0, 0.0, 0.0]
+
+    steps = [lb.Step("up", (0.5, 0, 0)), lb.Step("over", (1.0, 0, 0), wait=0.3, blends=True)]
+    motion, waits, _serial, _q = lb.timed(steps, ik1, [0.0] * 6)
+    assert motion == pytest.approx(lb.move_time([0.0] * 6, [1.0] + [0.0] * 5))
+    assert waits == pytest.approx(0.3)
+    stop_and_go = copy.deepcopy(data)
+    stop_and_go["arm"]["blend_z"] = 0.0
+    blended = lb.bound_of(config_from_dict(data), ik)
+    assert blended["motion"] < lb.bound_of(config_from_dict(stop_and_go), ik)["motion"]

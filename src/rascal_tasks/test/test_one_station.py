@@ -119,3 +119,48 @@ def test_a_sherd_recorded_lost_on_the_scale_is_left_there(config):
     scale._last.status = "done"
     assert scale.while_away(arm_free=True) is True
     assert left.station == "pickup"
+
+
+def test_the_carry_lowers_the_sherd_onto_the_tared_scale_without_a_stop(config):
+    """The scale tared while away and holding: the carry goes on down to where the sherd is
+    let go (one motion, Batch.move_through), no second descent at the scale."""
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    outcome, _batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    scale = config.stations["scale"]
+    travel = config["arm"]["travel_z"]
+    at_scale = [m for m in world.moves if m[:2] == tuple(scale.place_at)]
+    # carried, lowered to let it go (a step of the same motion), lifted with the way out
+    carry = next(c for c in world.chains if c[-1][:2] == tuple(scale.place_at))
+    assert [s[2] for s in carry[-2:]] == [travel, at_scale[1][2]] and carry[-1][4] is True
+    assert at_scale[0][2] == travel and at_scale[1][2] < travel and at_scale[2][2] == travel
+    # straight up from the sherd and on to the camera's standby, one motion
+    way_out = [c for c in world.chains if c[-1][:2] == tuple(config["arm"]["standby"])][0]
+    assert way_out[0][:3] == (*scale.place_at, travel) and way_out[0][4] is True
+
+
+def test_a_pan_disturbed_during_the_carry_is_tared_with_the_sherd_clear_of_it(config):
+    """Ready when the carry started, not at the arrival (something landed on the pan): the
+    arm goes back up above the scale before the tare, then down to let the sherd go."""
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    scale = config.stations["scale"]
+    grain = Sherd("grain", 0.0, 0.0, mass=0.002)
+
+    def refuse(x, y, z, yaw, linear):
+        if world.held is not None and (x, y) == tuple(scale.place_at) and grain not in world.sherds:
+            if z < config["arm"]["travel_z"]:
+                world.sherds.append(grain)
+                world.put(grain, x + 0.05, y)  # on the pan, beside where the sherd goes
+        return None
+
+    world.refuse = refuse
+    outcome, _batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    at_scale = [m for m in world.moves if m[:2] == tuple(scale.place_at)]
+    travel = config["arm"]["travel_z"]
+    # down with the carry, back up (linear) for the tare, down again
+    zs = [m[2] for m in at_scale]
+    first_low = next(i for i, z in enumerate(zs) if z < travel)
+    assert zs[first_low + 1] == travel and at_scale[first_low + 1][4] is True
+    assert zs[first_low + 2] < travel
+    assert rec.sherds[1].mass == pytest.approx(0.02, abs=1e-6)  # the grain tared away

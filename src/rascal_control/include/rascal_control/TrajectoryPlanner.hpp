@@ -16,6 +16,12 @@ namespace rascal_control {
 // Same values as rascal_msgs/MoveArm's result codes.
 enum class PlanCode { Ok = 0, Unreachable = 1, Collision = 2, InvalidGoal = 5 };
 
+// One move of a chain (TrajectoryPlanner::planChain): to `goal` by a joint or a linear move.
+struct ChainStep {
+  KDL::Frame goal;
+  bool linear = false;
+};
+
 struct PlanResult {
   PlanCode code = PlanCode::InvalidGoal;
   std::string message;
@@ -48,6 +54,16 @@ class TrajectoryPlanner {
   // ee_gripper_link along the straight line (orientation interpolated) from FK(start) to `goal`.
   PlanResult planLinear(const JointVector& start, const KDL::Frame& goal, double speed_scale);
 
+  // The moves to `steps` in order, each planned from where the one before ends (as
+  // planJointToPose / planLinear). With `blend_above` > 0 [m] they are blended: each move starts
+  // as early before the one before has stopped as it can while, over the overlap, the gripper
+  // (ee_gripper_link) stays above z = blend_above in base_link, every joint within its speed and
+  // acceleration limits and every link clear of the fixtures; below that height every move runs
+  // as planned alone (straight descents and lifts stay straight). A step that fails fails the
+  // chain, its message naming the step.
+  PlanResult planChain(const JointVector& start, const std::vector<ChainStep>& steps,
+                       double blend_above, double speed_scale);
+
   // Scales a trajectory's time so that it stays inside the limits, checked every `dt` and on
   // both sides of every piece boundary; returns the factor used (1 = unchanged).
   double enforceLimits(Trajectory& trajectory, double speed_scale, double dt = 0.0001) const;
@@ -57,6 +73,9 @@ class TrajectoryPlanner {
  private:
   bool validStart(const JointVector& start, double speed_scale, PlanResult& result) const;
   bool collisionFree(const JointPath& path, PlanResult& result) const;
+  // Whether `second` may start `overlap` [s] before `first` ends (planChain's rules).
+  bool blendable(const Trajectory& first, const Trajectory& second, double overlap,
+                 double blend_above, double speed_scale) const;
   TimeScaling timeOptimal(const JointPath& path, double speed_scale) const;
 
   const KinematicModel& model_;

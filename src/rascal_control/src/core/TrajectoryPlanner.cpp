@@ -16,6 +16,15 @@ constexpr double kAccelerationMargin = 0.98;
 constexpr int kGridPerSegment = 8;
 constexpr int kMinGrid = 64;
 constexpr int kMaxRefinements = 3;
+constexpr double kBlendStep = 0.002;  // [s] blended overlaps are checked this often (< 0.01 rad a step)
+// Overlaps tried at a corner, as fractions of the shorter move; the first that passes is taken.
+constexpr double kBlendFractions[] = {1.0,  0.95, 0.9,  0.85, 0.8,  0.75, 0.7,  0.65, 0.6, 0.55,
+                                     0.5,  0.45, 0.4,  0.35, 0.3,  0.25, 0.2,  0.15, 0.1, 0.05};
+// Straight moves of a blended chain are planned at this fraction of the limits: the joints the
+// move next to them also drives keep some acceleration for it (at 1.0 a lift's braking elbow and
+// the carry's starting one add up past the limit, and only a tenth of the lift overlaps;
+// 0.9 lets the carry start about half-way up the lift: TrajectoryPlannerTest).
+constexpr double kBlendedLinearScale = 0.9;
 
 std::string vectorText(const KDL::Vector& v) {
   char text[64];
@@ -215,6 +224,86 @@ PlanResult TrajectoryPlanner::planLinear(const JointVector& start, const KDL::Fr
   result.code = PlanCode::Unreachable;
   result.message = "linear move: no joint path stays on the line";
   return result;
+}
+
+PlanResult TrajectoryPlanner::planChain(const JointVector& start, const std::vector<ChainStep>& steps,
+                                        double blend_above, double speed_scale) {
+  PlanResult result;
+  if (steps.empty()) {
+    result.code = PlanCode::InvalidGoal;
+    result.message = "a chain of no moves";
+    return result;
+  }
+  std::vector<Trajectory> moves;
+  std::vector<double> starts;
+  JointVector from = start;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const double linear_scale = blend_above > 0.0 ? speed_scale * kBlendedLinearScale : speed_scale;
+    PlanResult step = steps[i].linear ? planLinear(from, steps[i].goal, linear_scale)
+                                      : planJointToPose(from, steps[i].goal, speed_scale);
+    if (!step.ok()) {
+      step.message = "move " + std::to_string(i + 1) + " of " + std::to_string(steps.size()) +
+                     " (to " + vectorText(steps[i].goal.p) + "): " + step.message;
+      return step;
+    }
+    from = step.trajectory.goal();
+    if (moves.empty()) {
+      starts.push_back(0.0);
+    } else {
+      const Trajectory& before = moves.back();
+      // never three moves at once: this one starts after the one before the last has ended
+      const double earliest =
+          moves.size() >= 2 ? starts[starts.size() - 2] + moves[moves.size() - 2].duration() : 0.0;
+      const double end = starts.back() + before.duration();
+      double overlap = 0.0;
+      if (blend_above > 0.0) {
+        const double longest =
+            std::min({before.duration(), step.trajectory.duration(), end - earliest});
+        for (double fraction : kBlendFractions) {
+          if (longest * fraction > kBlendStep &&
+              blendable(before, step.trajectory, longest * fraction, blend_above, speed_scale)) {
+            overlap = longest * fraction;
+            break;
+          }
+        }
+      }
+      starts.push_back(end - overlap);
+    }
+    moves.push_back(step.trajectory);
+  }
+  result.code = PlanCode::Ok;
+  result.message = "ok";
+  result.trajectory = moves.size() == 1 ? moves.front() : Trajectory::chain(moves, starts);
+  return result;
+}
+
+bool TrajectoryPlanner::blendable(const Trajectory& first, const Trajectory& second, double overlap,
+                                  double blend_above, double speed_scale) const {
+  const double begin = first.duration() - overlap;
+  const Trajectory both = Trajectory::chain({first, second}, {0.0, begin});
+  std::vector<JointVector> samples;
+  for (double t = begin; t <= first.duration() + 1e-12; t += kBlendStep) {
+    const Trajectory::Sample s = both.sample(t);
+    if (model_.forward(s.q).p.z() < blend_above) {
+      return false;
+    }
+    for (std::size_t j = 0; j < kArmJoints; ++j) {
+      // each move alone keeps within the limits (a joint move's slowest joint at them)
+      if (std::fabs(s.qd[j]) > model_.limits()[j].velocity * speed_scale * (1.0 + 1e-9) ||
+          std::fabs(s.qdd[j]) > options_.max_acceleration * speed_scale * (1.0 + 1e-9)) {
+        return false;
+      }
+    }
+    samples.push_back(s.q);
+  }
+  if (collisions_ != nullptr) {
+    for (const JointVector& q : samples) {
+      if (collisions_->check(q)) {
+        return false;
+      }
+    }
+  }
+  return true;
 }
 
 TimeScaling TrajectoryPlanner::timeOptimal(const JointPath& path, double speed_scale) const {

@@ -1,6 +1,7 @@
 #include "MoveServer.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include <trajectory_msgs/JointTrajectory.h>
@@ -82,10 +83,17 @@ PlanResult MoveServer::plan(const rascal_msgs::MoveArmGoal& goal, const JointVec
         failed.message = "pose goal: " + why;
         return failed;
       }
+      if (!goal.then_poses.empty()) {
+        return planChain(goal, target_pose, linear, start, scale);
+      }
       return linear ? planner_.planLinear(start, target_pose, scale)
                     : planner_.planJointToPose(start, target_pose, scale);
     }
     case rascal_msgs::MoveArmGoal::TARGET_NAMED: {
+      if (!goal.then_poses.empty()) {
+        failed.message = "then_poses need a pose target (target_type TARGET_POSE)";
+        return failed;
+      }
       const auto it = params_.named_poses.find(goal.named_pose);
       if (it == params_.named_poses.end()) {
         std::string known;
@@ -97,6 +105,10 @@ PlanResult MoveServer::plan(const rascal_msgs::MoveArmGoal& goal, const JointVec
       break;
     }
     case rascal_msgs::MoveArmGoal::TARGET_JOINTS:
+      if (!goal.then_poses.empty()) {
+        failed.message = "then_poses need a pose target (target_type TARGET_POSE)";
+        return failed;
+      }
       if (goal.joints.size() != kArmJoints) {
         failed.message = "joint goal has " + std::to_string(goal.joints.size()) + " values, expected 6";
         return failed;
@@ -116,6 +128,38 @@ PlanResult MoveServer::plan(const rascal_msgs::MoveArmGoal& goal, const JointVec
     return planner_.planLinear(start, model_.forward(target_joints), scale);
   }
   return planner_.planJoint(start, target_joints, scale);
+}
+
+PlanResult MoveServer::planChain(const rascal_msgs::MoveArmGoal& goal, const KDL::Frame& first, bool linear,
+                                 const JointVector& start, double scale) {
+  PlanResult failed;
+  failed.code = PlanCode::InvalidGoal;
+  if (goal.then_motions.size() != goal.then_poses.size()) {
+    failed.message = "then_motions has " + std::to_string(goal.then_motions.size()) +
+                     " values for " + std::to_string(goal.then_poses.size()) + " then_poses";
+    return failed;
+  }
+  if (!std::isfinite(goal.blend_above)) {
+    failed.message = "blend_above is not finite";
+    return failed;
+  }
+  std::vector<ChainStep> steps{{first, linear}};
+  for (std::size_t i = 0; i < goal.then_poses.size(); ++i) {
+    const uint8_t motion = goal.then_motions[i];
+    if (motion != rascal_msgs::MoveArmGoal::MOTION_JOINT && motion != rascal_msgs::MoveArmGoal::MOTION_LINEAR) {
+      failed.message = "then_motions[" + std::to_string(i) + "] = " + std::to_string(motion) + " (0 joint, 1 linear)";
+      return failed;
+    }
+    ChainStep step;
+    std::string why;
+    if (!poseToFrame(goal.then_poses[i], step.goal, why)) {
+      failed.message = "then_poses[" + std::to_string(i) + "]: " + why;
+      return failed;
+    }
+    step.linear = motion == rascal_msgs::MoveArmGoal::MOTION_LINEAR;
+    steps.push_back(step);
+  }
+  return planner_.planChain(start, steps, goal.blend_above, scale);
 }
 
 int MoveServer::driverSubscribers() const { return static_cast<int>(command_pub_.getNumSubscribers()); }

@@ -31,6 +31,9 @@ class MoveServer {
   void execute(const rascal_msgs::MoveArmGoalConstPtr& goal);
   rascal_msgs::MoveArmResult run(const rascal_msgs::MoveArmGoal& goal);
   PlanResult plan(const rascal_msgs::MoveArmGoal& goal, const JointVector& start);
+  // A goal with then_poses: `first` (the goal's pose) and the rest, as one chain (core mutex held).
+  PlanResult planChain(const rascal_msgs::MoveArmGoal& goal, const KDL::Frame& first, bool linear,
+                       const JointVector& start, double scale);
 
   JointStates& states_;
   const KinematicModel& model_;

@@ -141,6 +141,28 @@ class Arm:
         goal.pose = to_pose_stamped(pose)
         return self._run(goal, timeout)
 
+    def move_through(
+        self,
+        poses: Sequence,
+        motions: Sequence[str],
+        blend_above: float = 0.0,
+        speed_scale: float = 1.0,
+        timeout: Optional[float] = None,
+    ) -> MoveResult:
+        """Move ee_gripper_link to each of `poses` in turn ("joint" or "linear" for each), as one
+        goal: with `blend_above` > 0 [m], the next move starts before the one before has stopped
+        wherever the gripper stays above that height (MoveArm.action). Done when the last pose is
+        reached."""
+        if len(poses) != len(motions) or not poses:
+            raise ValueError("move_through: one motion per pose, at least one pose")
+        goal = self._goal(motions[0], speed_scale)
+        goal.target_type = goal.TARGET_POSE
+        goal.pose = to_pose_stamped(poses[0])
+        goal.then_poses = [to_pose_stamped(p).pose for p in poses[1:]]
+        goal.then_motions = [self._goal(m, speed_scale).motion for m in motions[1:]]  # checked
+        goal.blend_above = float(blend_above)
+        return self._run(goal, timeout)
+
     def go(
         self,
         name: str,

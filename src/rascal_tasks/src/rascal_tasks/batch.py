@@ -52,6 +52,11 @@ class Batch:
         # the grasp (an Observation) the arm stands ready to close on, open around the sherd:
         # a station brought it there while it waited (manipulation.grasp); any move clears it
         self.poised: Optional[Observation] = None
+        # (x, y, yaw): the gripper is low at (x, y) and goes straight up to travel height before
+        # its next move, blended into it (lift_later); None when it is not
+        self.lift_pending: Optional[tuple] = None
+        # the station the last move lowered the held sherd at, ready to let go (Translate)
+        self.lowered_at = None
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
         self.lift_slips: List[Observation] = []  # grasped sherds that slipped out while lifted
         self.unchecked_slips: List[Observation] = []  # ... not yet looked for by a survey
@@ -113,12 +118,36 @@ class Batch:
             raise RigError("batch", "PREEMPTED", "stop requested")
 
     def move_down(self, x, y, z, yaw, linear=False):
+        if self.lift_pending is not None:
+            return self.move_through([(x, y, z, yaw, linear)])
         self.check_stop()
         self.last_pose = None  # unknown until the arm got there
-        self.poised = None
+        self.poised = self.lowered_at = None
         with self.phase("locomotion"):
             self.rig.arm.move_down(x, y, z, yaw, linear=linear)
         self.last_pose = (x, y, yaw)
+
+    def move_through(self, steps):
+        """To each of `steps` ((x, y, z, yaw, linear) as move_down's) in turn, as one motion:
+        the next move starts before the one before has stopped wherever the gripper stays above
+        arm.blend_z (rig.Arm.move_through); a pending lift (lift_later) goes first."""
+        if self.lift_pending is not None:
+            x, y, yaw = self.lift_pending
+            steps = [(x, y, self.travel_z(), yaw, True)] + list(steps)
+            self.lift_pending = None
+        self.check_stop()
+        self.last_pose = None
+        self.poised = self.lowered_at = None
+        with self.phase("locomotion"):
+            self.rig.arm.move_through(steps, self.config["arm"]["blend_z"])
+        x, y, _z, yaw, _linear = steps[-1]
+        self.last_pose = (x, y, yaw)
+
+    def lift_later(self, x, y, yaw):
+        """The gripper, low at (x, y), goes straight up to travel height as the first part of
+        the next move (move_down, move_through), blended into it: for a lift whose next move
+        follows at once, with nothing to check in between."""
+        self.lift_pending = (x, y, yaw)
 
     def number_to_next_pick(self, s: "SherdRecord", unused: str):
         """The sherd in progress, not measured, lies among the bag's sherds on the pickup mat

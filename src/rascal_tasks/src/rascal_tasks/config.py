@@ -504,6 +504,15 @@ def _check_arm(source: str, arm: dict, stations: Dict[str, Station]):
             "surface or wall (%.3f m)" % max(highest, walls),
             travel_z,
         )
+    blend_z = arm["blend_z"]
+    if blend_z > 0 and not max(highest, walls) + 0.02 <= blend_z <= travel_z:
+        _fail(
+            source,
+            "arm.blend_z",
+            "expected between 0.02 m above the highest station surface or wall (%.3f m) and "
+            "arm.travel_z (%.3f m), or 0 for no blending" % (max(highest, walls), travel_z),
+            blend_z,
+        )
     standby = tuple(arm["standby"])
     if not top_down_reachable(standby[0], standby[1], travel_z):
         _fail(source, "arm.standby", "outside the arm's top-down reach at travel_z", list(standby))

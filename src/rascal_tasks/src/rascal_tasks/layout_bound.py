@@ -19,13 +19,18 @@ With the camera over the scale (`over_scale`, the one-station layout) the sherd 
 once: the scale settles while the arm lifts and goes to standby, the shutter, the way back
 during the transfer, the grasp for the discard box.
 
+Moves the workflow makes as one motion (`Batch.move_through`, with arm.blend_z > 0: the carry
+and the descent at a station, a repick's lift and the carry, the lift and the way to standby)
+are timed as one move from where the first starts to where the last ends: no motion through
+those points can be faster, whatever corner it cuts.
+
 Pickup spots are averaged over a grid of the pickup area; the lawnmower survey is shared by the
 batch's sherds. No ROS here: `rosrun rascal_tasks layout_bound` (scripts/) gives `bound_of` the
 arm controller's IK.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Dict, List, Tuple
 
 from rascal_tasks.config import Config
@@ -61,6 +66,7 @@ class Step:
     serial_wait: float = 0.0  # [s] more as the workflow runs today: in series, but for...
     overlaps_next: bool = False  # ...the next move, made meanwhile
     wait_during: int = 0  # `wait` runs on during this many next moves: only its excess counts
+    blends: bool = False  # one motion with the step before (which then has no wait of its own)
 
 
 def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> List[Step]:
@@ -70,6 +76,7 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
     arm, scale = cfg["arm"], cfg["scale"]
     margin_stroke = arm["gripper"]["stroke_time"] * arm["grasp_margin"] / 0.044  # of 30..74 mm
     travel, approach = arm["travel_z"], arm["approach_offset"]
+    blend = arm["blend_z"] > 0
     steps: List[Step] = []
     px, py = pickup_xy
     z0 = cfg.stations["pickup"].surface_z + GRASP_HEIGHT
@@ -78,25 +85,30 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
     steps += [
         Step("approach pickup", (px, py, z0 + approach), wait=margin_stroke),  # open on the way
         Step("descend", (px, py, z0), wait=margin_stroke),  # close
-        Step("lift", (px, py, travel)),
+        Step("lift", (px, py, travel)),  # on its own: a slip on the way up is looked for
     ]
+    repicked = False  # the last lift was a repick's: made as one motion with the carry
     order = cfg.station_order()
     for name, after in zip(order, order[1:] + [None], strict=True):
         st = cfg.stations[name]
         if st.type == "discard":
             x, y = st.place_at
-            steps.append(Step("over discard", (x, y, travel), wait=margin_stroke))  # let go
+            # let go over it
+            steps.append(Step("over discard", (x, y, travel), wait=margin_stroke, blends=repicked))
             continue
         if not st.over_scale:  # over the scale (one station) it is shot where it lies
             x, y = st.place_at
             z = st.surface_z + GRASP_HEIGHT + arm["place_clearance"]
-            steps.append(Step("over " + name, (x, y, travel)))  # a scale tared meanwhile
-            steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke))
+            # a scale tared meanwhile: carried and lowered as one motion
+            steps.append(Step("over " + name, (x, y, travel), blends=blend and repicked))
+            steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke, blends=blend))
         if st.type == "scale":
             settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
             if after is not None and cfg.stations[after].over_scale:
-                # it settles while the arm goes up and out of the camera's view (make_way)
-                steps.append(Step("scale settles", (x, y, z), wait=settle, wait_during=2))
+                # it settles while the arm goes up and out of the camera's view (make_way:
+                # one motion, or two)
+                moves = 1 if blend else 2
+                steps.append(Step("scale settles", (x, y, z), wait=settle, wait_during=moves))
                 steps.append(Step("lift", (x, y, travel)))
                 continue  # the camera over it takes it from here
             steps.append(Step("hover", (x, y, z + approach), wait=settle))  # while it settles
@@ -111,6 +123,7 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
                     wait=SHUTTER,
                     serial_wait=TRANSFER,
                     overlaps_next=True,
+                    blends=blend and st.over_scale,  # up from the scale and away, one motion
                 )
             )
             steps.append(Step("back over " + name, (x, y, z + approach)))
@@ -118,7 +131,22 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
             steps.append(Step("lift", (x, y, travel)))
         steps.append(Step("descend", (x, y, z), wait=margin_stroke))
         steps.append(Step("lift", (x, y, travel)))
+        repicked = blend
     return steps
+
+
+def merged(steps: List[Step]) -> List[Step]:
+    """`steps` with each run of blended steps as one step: to the run's last pose, with its
+    last step's waits."""
+    out: List[Step] = []
+    for s in steps:
+        if s.blends and out:
+            prev = out[-1]
+            assert not (prev.wait or prev.serial_wait or prev.wait_during), prev.what
+            out[-1] = replace(s, what=prev.what + " + " + s.what, blends=False)
+        else:
+            out.append(s)
+    return out
 
 
 def camera_over_steps(cfg: Config, spots, what: str) -> List[Step]:
@@ -142,7 +170,7 @@ def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, 
     q, motion, waits, serial = start, 0.0, 0.0, 0.0
     overlapping = 0.0  # a serial wait the next move is made during
     running, moves_left = 0.0, 0  # a wait the next moves are made during (Step.wait_during)
-    for s in steps:
+    for s in merged(steps):
         q1 = ik(*s.pose, q)
         move = move_time(q, q1)
         motion += move

@@ -106,9 +106,11 @@ def reach(b, o: Observation) -> None:
     b.poised = o
 
 
-def grasp(b, o: Observation, station) -> bool:
+def grasp(b, o: Observation, station, lift=True) -> bool:
     """Reach for `o` (unless the arm is poised there already: a station brought it while it
-    waited), close, lift.
+    waited), close, lift. With `lift` False a sherd held is lifted as the first part of the
+    arm's next move, blended into it (Batch.lift_later: the carry to the next station); one
+    that slips out on the way up is then found missing there and looked for like a drop.
     Raises SherdFailure when the arm refuses the approach or the descent (failures.py)."""
     if b.poised != o:
         with _aiming_at(o, station):
@@ -116,6 +118,9 @@ def grasp(b, o: Observation, station) -> bool:
     b.poised = None
     with b.phase("grasping"):
         held = b.rig.gripper.close().holding
+    if held and not lift:
+        b.lift_later(o.grasp_x, o.grasp_y, o.grasp_yaw)
+        return True
     b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
     if held and not b.rig.gripper.holding():
         held = False  # slipped out while lifting (survey.account_for_slips looks for it)
@@ -126,9 +131,9 @@ def grasp(b, o: Observation, station) -> bool:
     return held
 
 
-def grasp_retrying(b, o: Observation, station, like=None):
+def grasp_retrying(b, o: Observation, station, like=None, lift=True):
     """Grasp `o` at `station`; after a miss, detect again around it and grasp the detection
-    nearest it (or least `like`), up to recovery.max_grasp_attempts in all.
+    nearest it (or least `like`), up to recovery.max_grasp_attempts in all; `lift` as grasp's.
     Returns (the last observation tried, grasps made, whether it is held)."""
     rec = b.config["recovery"]
     like = like or (lambda c, last: c.distance_to(last.x, last.y))
@@ -138,7 +143,7 @@ def grasp_retrying(b, o: Observation, station, like=None):
             yaw = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
             if yaw != o.grasp_yaw:
                 o = dataclasses.replace(o, grasp_yaw=yaw)
-        if grasp(b, o, station):
+        if grasp(b, o, station, lift):
             return o, attempt + 1, True
         if attempt + 1 == rec["max_grasp_attempts"]:
             break

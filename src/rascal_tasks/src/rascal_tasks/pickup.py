@@ -27,6 +27,9 @@ class Pickup(BatchState):
 
     def run(self):
         b = self.batch
+        # the first station may get ready for this sherd meanwhile (the scale's tare, then
+        # checked by the time the sherd is carried there: lowered onto it without a stop)
+        b.plugins[0].while_away(arm_free=False)
         o = b.pending.pop(0)
         if b.pending_stale:
             # the mat changed since the survey (a grasp here): the sherd is grasped where the
@@ -37,6 +40,8 @@ class Pickup(BatchState):
                 return "missed"
         b.pending_stale = True
         slips = len(b.lift_slips)
+        # lifted at once, not as part of the carry: a sherd that slips out on the way up has
+        # no number yet, and is looked for by the next survey
         o, tries, held = grasp_retrying(b, o, b.pickup)
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
         # again (survey.account_for_slips), unless the retry took it at once

@@ -127,6 +127,14 @@ class Arm:
         Raises RigError (UNREACHABLE, COLLISION, TIMEOUT, PREEMPTED)."""
         raise NotImplementedError
 
+    def move_through(self, steps: List[tuple], blend_above: float) -> float:
+        """Move down to each of `steps` ((x, y, z, yaw, linear) as move_down's) in turn; a rig
+        that can blends them where the gripper stays above `blend_above` [m] (the next move
+        starts before the one before has stopped). Here: one move_down after the other.
+        Returns seconds taken; raises as move_down."""
+        del blend_above
+        return sum(self.move_down(*step) for step in steps)
+
     def go(self, named: str) -> float:
         raise NotImplementedError
 

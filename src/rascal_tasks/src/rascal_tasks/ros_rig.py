@@ -216,6 +216,24 @@ class RosArm(rig.Arm):
             except ControlError as e:
                 raise _rig_error("arm", e) from None
 
+    def move_through(self, steps, blend_above):
+        poses = [ControlArm.top_down(x, y, z, yaw) for x, y, z, yaw, _linear in steps]
+        motions = ["linear" if step[4] else "joint" for step in steps]
+        for attempt in range(2):
+            try:
+                return self._arm.move_through(
+                    poses, motions, blend_above, speed_scale=self.speed_scale
+                ).duration
+            except Timeout as e:
+                # as move_down: once more from where the arm is, every move of the chain (a
+                # lost trajectory left the arm at the start; after a stall part-way, the arm
+                # goes back through the moves' own targets, each move collision-checked)
+                if attempt or e.result is None:
+                    raise _rig_error("arm", e) from None
+                rospy.logwarn("arm: %s; trying the moves once more", e.message)
+            except ControlError as e:
+                raise _rig_error("arm", e) from None
+
     def go(self, named):
         try:
             return self._arm.go(named, speed_scale=self.speed_scale).duration

@@ -31,12 +31,20 @@ class Translate(BatchState):
     def run(self):
         b = self.batch
         plugin = b.plugins[self.index]
+        s = b.sherd
         # the station may get ready for it meanwhile (a scale whose pan has stood empty since
         # the last sherd left it is tared now: with the camera over the scale no later
         # station's work gave it the time)
         plugin.while_away(arm_free=False)
-        st = plugin.target(b.sherd)
-        b.move_down(*st.place_at, b.travel_z(), station_yaw(b.config, st, b.sherd.grasp_yaw))
+        st = plugin.target(s)
+        yaw = station_yaw(b.config, st, s.grasp_yaw)
+        steps = [(*st.place_at, b.travel_z(), yaw, False)]
+        lower = not plugin.release_from_above and plugin.ready_for_place(s, by_arrival=True)
+        if lower:  # on down to where it is let go, as one motion with the carry (and the lift)
+            steps.append((*st.place_at, place_z(b, st, s), yaw, True))
+        b.move_through(steps)
+        if lower:
+            b.lowered_at = st
         if not b.rig.gripper.holding():
             b.sherd.dropped("while carrying to %s" % st.name)
             return "dropped"
@@ -58,19 +66,24 @@ class Place(BatchState):
         plugin = b.plugins[self.index]
         s = b.sherd
         st = plugin.target(s)
-        plugin.before_place(s)
         yaw = station_yaw(b.config, st, s.grasp_yaw)
-        if not plugin.release_from_above:
-            z = st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
-            b.move_down(*st.place_at, z, yaw, linear=True)
+        lowered = b.lowered_at is st  # the carry brought it down already
+        if lowered and not plugin.ready_for_place(s):
+            # no longer ready (the scale's pan moved since its tare): back up, for the station
+            # to get ready with the sherd well clear of it
+            b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
+            lowered = False
+        plugin.before_place(s)
+        if not plugin.release_from_above and not lowered:
+            b.move_down(*st.place_at, place_z(b, st, s), yaw, linear=True)
         with b.phase("grasping"):
             # picked up again as wide as the fingers held it (a chord longer than its width)
             s.width = release(b, s.width)
         after = b.plugins[self.index + 1] if self.index + 1 < len(b.plugins) else None
         if after is not None and after.stays:
             # the next station works on it here (the camera over the scale): straight up, and
-            # out of its way while this one measures (the scale settles meanwhile)
-            b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
+            # out of its way while this one measures (the scale settles meanwhile), as one motion
+            b.lift_later(*st.place_at, yaw)
             s.placed(st, yaw)
             after.make_way(s)
             return "placed"
@@ -81,6 +94,11 @@ class Place(BatchState):
             b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
         s.placed(st, yaw)
         return "placed"
+
+
+def place_z(b, st, s) -> float:
+    """Where the gripper lets the held sherd `s` go at station `st`: just clear of it."""
+    return st.surface_z + s.grasp_height + b.config["arm"]["place_clearance"]
 
 
 class AtStation(BatchState):
@@ -139,19 +157,20 @@ class Repick(BatchState):
         return "Repick@%s" % self.batch.station_names[self.index]
 
     def run(self):
-        return "held" if repick(self.batch, self.index) else "lost"
+        # held, it is lifted as the carry to the next station starts (Translate)
+        return "held" if repick(self.batch, self.index, lift=False) else "lost"
 
 
-def repick(b, index) -> bool:
+def repick(b, index, lift=True) -> bool:
     """Pick the sherd in progress up again where it was set down at station `index`: blind
     first (where it was placed, as it was held), then from a fresh look on each miss. False,
-    with the sherd recorded lost, when it could not be taken."""
+    with the sherd recorded lost, when it could not be taken. `lift` as manipulation.grasp's."""
     s = b.sherd
     st = b.plugins[index].lies_at
     x, y = s.last_xy
     o = placed_observation(b, s, st)
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
-        if grasp(b, o, st):
+        if grasp(b, o, st, lift):
             return True
         seen = survey_at(b, st, x, y)
         if not seen:

@@ -73,6 +73,12 @@ class StationPlugin:
         """Called with the sherd (a SherdRecord) in the gripper above the station (e.g. tare
         the scale)."""
 
+    def ready_for_place(self, sherd, by_arrival: bool = False) -> bool:
+        """Whether the held `sherd` may be lowered onto this station without the arm stopping
+        above it first (before_place then needs the arm nowhere in particular). `by_arrival`:
+        whether it looks set to be by the time the carry gets there (Place asks again there)."""
+        return True
+
     def while_away(self, arm_free: bool = True) -> bool:
         """Called while the arm works at a later station, the sherd gone from this one, or
         carries the next sherd here, or surveys the pickup mat: a station may start here,
@@ -83,8 +89,9 @@ class StationPlugin:
 
     def make_way(self, sherd) -> None:
         """For a station that `stays`: the sherd was just set down by the station before, the
-        arm above it at travel height; it may go where this station needs it while the one
-        before measures (the camera's standby)."""
+        gripper still low at it, going straight up as the first part of its next move
+        (Batch.lift_later); it may go where this station needs it while the one before
+        measures (the camera's standby)."""
 
     def reach_back(self, sherd) -> None:
         """The arm back at `sherd`, lying here, the fingers open around it, ready to pick it up
@@ -302,6 +309,20 @@ class ScaleStation(StationPlugin):
             return "the empty platform reads %.1f g after the tare" % (zero.mass * 1000)
         return None
 
+    def ready_for_place(self, sherd, by_arrival=False):
+        """Only with the tare made while away holding (the pan steady at zero for a window): a
+        tare made now needs the sherd well clear of the pan, the arm above it. By the arrival:
+        that tare made, and every reading since it zero so far."""
+        early = self._early_tare
+        if early is None:
+            return False
+        readability = self._cfg()["readability"] + 1e-9
+        if by_arrival:
+            since = self.batch.rig.scale.readings(early[0])
+            return all(abs(r.mass) <= readability for r in since)
+        zero = self._settled_now(early[0])
+        return zero is not None and abs(zero.mass) <= readability
+
     def before_place(self, sherd):
         self._tared_for = None
         b = self.batch
@@ -481,7 +502,7 @@ class ArchivalCameraStation(StationPlugin):
         b = self.batch
         if self.at_sherd:
             x, y = sherd.last_xy
-            b.move_down(x, y, b.travel_z(), sherd.grasp_yaw, linear=True)
+            b.lift_later(x, y, sherd.grasp_yaw)  # up and away as one motion
             self.at_sherd = False
         sx, sy = b.config["arm"]["standby"]
         b.move_down(sx, sy, b.travel_z(), standby_yaw(b.config, self.station))
