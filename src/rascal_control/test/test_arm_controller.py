@@ -3,7 +3,8 @@
 Without a driver: parameter errors, the IK/FK services, FK, TF and the gripper state from a
 published /joint_states, goals failing cleanly.
 Against the simulator (`rosrun rascal_sim sim`, skipped until rascal_sim is built): a pose goal
-arrives within 2 mm, an unreachable goal returns UNREACHABLE within 1 s without moving the arm,
+arrives within 2 mm, a chain of moves blended above a height keeps straight below it, an
+unreachable goal returns UNREACHABLE within 1 s without moving the arm,
 a cancelled move stops, the gripper reports held on a sherd and not held on nothing (in its
 close results and on /rascal/gripper/state), and after a driver restart (/sim/reset) every goal
 is refused with DRIVER_RESTARTED until the restart is acknowledged.
@@ -254,6 +255,15 @@ class TestAgainstTheSimulator:
         out = self.client(rig, "linear_path")
         print(out)
         assert out["samples"] > 20 and out["deviation"] < 0.002, out
+
+    def test_a_chain_goes_straight_up_and_down_and_cuts_the_corners_above_the_blend(self, rig):
+        out = self.client(rig, "chain")
+        print(out)
+        assert out["samples"] > 20 and out["goal_error"] < 0.002, out
+        # below 0.06 m on the verticals through the two points (within the tracking)
+        assert out["stray"] < 0.003, out
+        # between them it never went up to the 0.10 m travel height: the corners were cut
+        assert out["crossed"] < 0.095, out
 
     def test_unreachable_goal_fails_fast_and_does_not_move(self, rig):
         out = self.client(rig, "unreachable")

@@ -65,6 +65,39 @@ def linear_path(arm):
     return {"samples": len(samples), "deviation": worst, "duration": result.duration}
 
 
+def chain(arm):
+    """A lift, a carry and a descent as one goal, blended above 0.06 m: every /joint_states
+    message of it through FK; how far below 0.06 m the path strays from the two verticals,
+    and the lowest height it crossed between them (a corner cut: below the 0.10 m travel)."""
+    a, b, travel = (0.15, 0.25), (0.25, -0.25), 0.10
+    arm.move_to(Arm.top_down(*a, 0.03, yaw=0.3))
+    samples = []
+    sub = rospy.Subscriber(
+        "/joint_states",
+        JointState,
+        lambda m: samples.append(dict(zip(m.name, m.position, strict=False))),
+    )
+    poses = [Arm.top_down(*a, travel, 0.3), Arm.top_down(*b, travel, 0.0)]
+    poses.append(Arm.top_down(*b, 0.04, 0.0))
+    arm.move_through(poses, ["linear", "joint", "linear"], blend_above=0.06)
+    sub.unregister()
+    time.sleep(0.2)
+    stray, crossed = 0.0, travel
+    for s in samples[::2]:
+        p = arm.compute_fk([s[n] for n in ARM]).pose.position
+        off = min(math.dist((p.x, p.y), a), math.dist((p.x, p.y), b))
+        if p.z < 0.06 - 0.001:
+            stray = max(stray, off)
+        elif off > 0.01:
+            crossed = min(crossed, p.z)
+    return {
+        "samples": len(samples),
+        "stray": stray,
+        "crossed": crossed,
+        "goal_error": pose_error(arm, *b, 0.04),
+    }
+
+
 def unreachable(arm):
     before = joints()
     start = time.monotonic()
@@ -220,6 +253,7 @@ def main():
                 "collision": collision,
                 "no_driver": no_driver,
                 "linear_path": linear_path,
+                "chain": chain,
             }[scenario]
             out = run(arm)
     except ControlError as e:
