@@ -20,7 +20,7 @@ once: the scale settles while the arm lifts and goes to standby, the shutter, th
 during the transfer, the grasp for the discard box.
 
 Moves the workflow makes as one motion (`Batch.move_through`, with arm.blend_z > 0: the carry
-and the descent at a station, a repick's lift and the carry, the lift and the way to standby)
+and the descent at a station, the lift from the scale and the way to standby)
 are timed as one move from where the first starts to where the last ends: no motion through
 those points can be faster, whatever corner it cuts.
 
@@ -85,22 +85,21 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
     steps += [
         Step("approach pickup", (px, py, z0 + approach), wait=margin_stroke),  # open on the way
         Step("descend", (px, py, z0), wait=margin_stroke),  # close
-        Step("lift", (px, py, travel)),  # on its own: a slip on the way up is looked for
+        Step("lift", (px, py, travel)),  # every grasp's lift alone: checked at the top
     ]
-    repicked = False  # the last lift was a repick's: made as one motion with the carry
     order = cfg.station_order()
     for name, after in zip(order, order[1:] + [None], strict=True):
         st = cfg.stations[name]
         if st.type == "discard":
             x, y = st.place_at
             # let go over it
-            steps.append(Step("over discard", (x, y, travel), wait=margin_stroke, blends=repicked))
+            steps.append(Step("over discard", (x, y, travel), wait=margin_stroke))
             continue
         if not st.over_scale:  # over the scale (one station) it is shot where it lies
             x, y = st.place_at
             z = st.surface_z + GRASP_HEIGHT + arm["place_clearance"]
             # a scale tared meanwhile: carried and lowered as one motion
-            steps.append(Step("over " + name, (x, y, travel), blends=blend and repicked))
+            steps.append(Step("over " + name, (x, y, travel)))
             steps.append(Step("place at " + name, (x, y, z), wait=margin_stroke, blends=blend))
         if st.type == "scale":
             settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
@@ -131,7 +130,6 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
             steps.append(Step("lift", (x, y, travel)))
         steps.append(Step("descend", (x, y, z), wait=margin_stroke))
         steps.append(Step("lift", (x, y, travel)))
-        repicked = blend
     return steps
 
 

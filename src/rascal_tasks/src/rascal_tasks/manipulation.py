@@ -106,11 +106,11 @@ def reach(b, o: Observation) -> None:
     b.poised = o
 
 
-def grasp(b, o: Observation, station, lift=True) -> bool:
+def grasp(b, o: Observation, station) -> bool:
     """Reach for `o` (unless the arm is poised there already: a station brought it while it
-    waited), close, lift. With `lift` False a sherd held is lifted as the first part of the
-    arm's next move, blended into it (Batch.lift_later: the carry to the next station); one
-    that slips out on the way up is then found missing there and looked for like a drop.
+    waited), close, lift. The lift is a move of its own, checked at the top: a sherd that slips
+    out on the way up falls back where it lay (blended into the carry, it would fall on the
+    way, off any station: bench/throughput, session 21).
     Raises SherdFailure when the arm refuses the approach or the descent (failures.py)."""
     if b.poised != o:
         with _aiming_at(o, station):
@@ -118,9 +118,6 @@ def grasp(b, o: Observation, station, lift=True) -> bool:
     b.poised = None
     with b.phase("grasping"):
         held = b.rig.gripper.close().holding
-    if held and not lift:
-        b.lift_later(o.grasp_x, o.grasp_y, o.grasp_yaw)
-        return True
     b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
     if held and not b.rig.gripper.holding():
         held = False  # slipped out while lifting (survey.account_for_slips looks for it)
@@ -131,9 +128,9 @@ def grasp(b, o: Observation, station, lift=True) -> bool:
     return held
 
 
-def grasp_retrying(b, o: Observation, station, like=None, lift=True):
+def grasp_retrying(b, o: Observation, station, like=None):
     """Grasp `o` at `station`; after a miss, detect again around it and grasp the detection
-    nearest it (or least `like`), up to recovery.max_grasp_attempts in all; `lift` as grasp's.
+    nearest it (or least `like`), up to recovery.max_grasp_attempts in all.
     Returns (the last observation tried, grasps made, whether it is held)."""
     rec = b.config["recovery"]
     like = like or (lambda c, last: c.distance_to(last.x, last.y))
@@ -143,7 +140,7 @@ def grasp_retrying(b, o: Observation, station, like=None, lift=True):
             yaw = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
             if yaw != o.grasp_yaw:
                 o = dataclasses.replace(o, grasp_yaw=yaw)
-        if grasp(b, o, station, lift):
+        if grasp(b, o, station):
             return o, attempt + 1, True
         if attempt + 1 == rec["max_grasp_attempts"]:
             break

@@ -40,8 +40,6 @@ class Pickup(BatchState):
                 return "missed"
         b.pending_stale = True
         slips = len(b.lift_slips)
-        # lifted at once, not as part of the carry: a sherd that slips out on the way up has
-        # no number yet, and is looked for by the next survey
         o, tries, held = grasp_retrying(b, o, b.pickup)
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
         # again (survey.account_for_slips), unless the retry took it at once

@@ -47,9 +47,7 @@ class Recover(BatchState):
         def unlike(c, _last=None):
             return unlikeness(c, like.length, like.width, ref)
 
-        o, tries, held = grasp_retrying(
-            b, min(candidates, key=unlike), station, like=unlike, lift=False
-        )
+        o, tries, held = grasp_retrying(b, min(candidates, key=unlike), station, like=unlike)
         if not held:
             why = "found but could not be picked up (%d grasps)" % tries
             if station is b.pickup and s.station_index < 0:

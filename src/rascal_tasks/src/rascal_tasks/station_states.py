@@ -40,7 +40,7 @@ class Translate(BatchState):
         yaw = station_yaw(b.config, st, s.grasp_yaw)
         steps = [(*st.place_at, b.travel_z(), yaw, False)]
         lower = not plugin.release_from_above and plugin.ready_for_place(s, by_arrival=True)
-        if lower:  # on down to where it is let go, as one motion with the carry (and the lift)
+        if lower:  # on down to where it is let go, as one motion with the carry
             steps.append((*st.place_at, place_z(b, st, s), yaw, True))
         b.move_through(steps)
         if lower:
@@ -157,20 +157,19 @@ class Repick(BatchState):
         return "Repick@%s" % self.batch.station_names[self.index]
 
     def run(self):
-        # held, it is lifted as the carry to the next station starts (Translate)
-        return "held" if repick(self.batch, self.index, lift=False) else "lost"
+        return "held" if repick(self.batch, self.index) else "lost"
 
 
-def repick(b, index, lift=True) -> bool:
+def repick(b, index) -> bool:
     """Pick the sherd in progress up again where it was set down at station `index`: blind
     first (where it was placed, as it was held), then from a fresh look on each miss. False,
-    with the sherd recorded lost, when it could not be taken. `lift` as manipulation.grasp's."""
+    with the sherd recorded lost, when it could not be taken."""
     s = b.sherd
     st = b.plugins[index].lies_at
     x, y = s.last_xy
     o = placed_observation(b, s, st)
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
-        if grasp(b, o, st, lift):
+        if grasp(b, o, st):
             return True
         seen = survey_at(b, st, x, y)
         if not seen:
