@@ -14,10 +14,9 @@ import os
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
-import yaml
 
 from rascal_tasks import rig, workflow
-from rascal_tasks.config import config_from_dict, merged
+from rascal_tasks.config import load_config
 from rascal_tasks.catalogue.errors import StatusError
 from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING
 from rascal_tasks.sorting import SherdValues, choose_bin
@@ -486,12 +485,10 @@ class Recorder:
 def shipped_config(*over):
     """config/rascal.yaml of this workspace, loaded as `rascal run` loads it, with the files
     `over` (relative to the workspace) merged over it."""
-    with open(os.path.join(WORKSPACE, "config", "rascal.yaml")) as f:
-        data = yaml.safe_load(f)
-    for layer in over:
-        with open(os.path.join(WORKSPACE, layer)) as f:
-            data = merged(data, yaml.safe_load(f))
-    return config_from_dict(data)
+    return load_config(
+        os.path.join(WORKSPACE, "config", "rascal.yaml"),
+        over=[os.path.join(WORKSPACE, layer) for layer in over],
+    )
 
 
 def run_batch(config, world: World, recorder: Optional[Recorder] = None):

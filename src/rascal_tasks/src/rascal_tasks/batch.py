@@ -164,6 +164,12 @@ class Batch:
         """The stations a sherd is carried to and set down at, in order (config Stations)."""
         return [p.station for p in self.plugins if not p.stays]
 
+    def next_stays(self, i: int):
+        """The plug-in after station `i` when it works on the sherd where `i` left it (`stays`:
+        the camera over the scale), else None."""
+        after = self.plugins[i + 1] if i + 1 < len(self.plugins) else None
+        return after if after is not None and after.stays else None
+
     def in_the_way(self, station) -> bool:
         """Whether a sherd left lying on `station` lies where a later sherd is placed."""
         return any(p.station is station and not p.release_from_above for p in self.plugins)

@@ -149,7 +149,7 @@ class Resume(BatchState):
                 if i != done:
                     return "STATION_%d" % i
                 # measured here; a camera over the scale shoots it where it lies
-                stays = i + 1 < len(b.plugins) and b.plugins[i + 1].stays
+                stays = b.next_stays(i) is not None
                 return ("STATION_%d" if stays else "REPICK_%d") % (i + stays)
         if done < 0 and self.pick_fallen(s, pickup_xy):
             return "TRANSLATE_0"

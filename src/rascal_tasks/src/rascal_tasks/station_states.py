@@ -79,8 +79,8 @@ class Place(BatchState):
         with b.phase("grasping"):
             # picked up again as wide as the fingers held it (a chord longer than its width)
             s.width = release(b, s.width)
-        after = b.plugins[self.index + 1] if self.index + 1 < len(b.plugins) else None
-        if after is not None and after.stays:
+        after = b.next_stays(self.index)
+        if after is not None:
             # the next station works on it here (the camera over the scale): straight up, and
             # out of its way while this one measures (the scale settles meanwhile), as one motion
             b.lift_later(*st.place_at, yaw)
@@ -207,14 +207,12 @@ class PutBack(BatchState):
         plugin = b.plugins[self.index]
         if isinstance(plugin, ScaleStation) and plugin.holds_something():
             # the grasp took one of the two: the other is fetched too, and set down apart
-            seen = survey_at(b, st, *st.place_at)
-            if not seen or not grasp(b, seen[0], st):
+            spot = clear_to_mat(b, st, self._spot_beside(spots[0]))
+            if spot is None:
                 raise SherdFailure(
                     "the second of two sherds lifted as one stays on the %s" % st.name, st
                 )
-            spots.append(self._spot_beside(spots[0]))
-            o = seen[0]  # set down as it was grasped, not as the first one was
-            set_down_on_mat(b, *spots[1], o.grasp_yaw, o.grasp_z - st.surface_z, o.width)
+            spots.append(spot)
         else:
             # both came in the one grasp and were set down together: if one still lies on the
             # other, the top one is taken apart (set down together they may not fall apart,
@@ -272,10 +270,11 @@ def set_down_on_mat(b, x, y, yaw, height, width):
     b.move_down(x, y, b.travel_z(), yaw, linear=True)
 
 
-def clear_to_mat(b, st) -> Optional[Tuple[float, float]]:
-    """A sherd left lying on station `st` (the fingers empty) taken back to the freest spot of
-    the pickup mat, where a later survey finds it like any other; that spot, or None when the
-    wrist camera sees nothing there or it could not be picked up."""
+def clear_to_mat(b, st, spot=None) -> Optional[Tuple[float, float]]:
+    """A sherd left lying on station `st` (the fingers empty) taken back to `spot` of the
+    pickup mat (default: its freest), set down as it was grasped, where a later survey finds it
+    like any other; that spot, or None when the wrist camera sees nothing there or it could not
+    be picked up (a refused grasp included)."""
     seen = survey_at(b, st, *st.place_at)
     if not seen:
         return None
@@ -285,7 +284,7 @@ def clear_to_mat(b, st) -> Optional[Tuple[float, float]]:
             return None
     except SherdFailure:
         return None  # its grasp was refused: it stays, and is said
-    x, y = free_spot(b.pickup.area, b.seen)
+    x, y = spot or free_spot(b.pickup.area, b.seen)
     set_down_on_mat(b, x, y, o.grasp_yaw, o.grasp_z - st.surface_z, o.width)
     b.pending_stale = True  # the mat changed: the next pick looks again
     return x, y

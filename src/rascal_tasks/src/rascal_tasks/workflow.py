@@ -74,7 +74,7 @@ def build_machine(batch: Batch):
         for i in range(n):
             last = i == n - 1
             # a camera over the scale shoots the sherd where it was weighed: no repick, no carry
-            after = "STATION_%d" % (i + 1) if not last and batch.plugins[i + 1].stays else None
+            after = "STATION_%d" % (i + 1) if batch.next_stays(i) else None
             add(
                 "TRANSLATE_%d" % i,
                 Translate(batch, i),
