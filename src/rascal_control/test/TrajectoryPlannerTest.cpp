@@ -182,14 +182,22 @@ std::vector<ChainStep> liftCarryDescend() {
           {topDown(0.25, -0.25, 0.04, 0.0), true}};
 }
 
+// A sherd grasped on the pickup mat: the arm's joints there, and a planner without fixtures.
+class TrajectoryChain : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    start_ = ik_.solve(topDown(0.15, 0.25, 0.02, 0.3), JointVector{});
+    ASSERT_TRUE(start_.ok()) << start_.message;
+  }
+  IkSolver ik_{testModel()};
+  TrajectoryPlanner planner_{testModel(), ik_, nullptr};
+  IkResult start_;
+};
+
 }  // namespace
 
-TEST(TrajectoryPlanner, ChainWithoutBlendingStopsAtEveryCorner) {
-  IkSolver ik(testModel());
-  TrajectoryPlanner planner(testModel(), ik, nullptr);
-  const IkResult start = ik.solve(topDown(0.15, 0.25, 0.02, 0.3), JointVector{});
-  ASSERT_TRUE(start.ok()) << start.message;
-  const PlanResult r = planner.planChain(start.joints, liftCarryDescend(), 0.0, 1.0);
+TEST_F(TrajectoryChain, WithoutBlendingItStopsAtEveryCorner) {
+  const PlanResult r = planner_.planChain(start_.joints, liftCarryDescend(), 0.0, 1.0);
   ASSERT_TRUE(r.ok()) << r.message;
   ASSERT_TRUE(r.trajectory.chained());
   double sum = 0.0;
@@ -207,14 +215,10 @@ TEST(TrajectoryPlanner, ChainWithoutBlendingStopsAtEveryCorner) {
   }
 }
 
-TEST(TrajectoryPlanner, BlendedChainIsFasterWithinTheLimitsAndAboveTheFloor) {
-  IkSolver ik(testModel());
-  TrajectoryPlanner planner(testModel(), ik, nullptr);
-  const IkResult start = ik.solve(topDown(0.15, 0.25, 0.02, 0.3), JointVector{});
-  ASSERT_TRUE(start.ok()) << start.message;
-  const PlanResult stop = planner.planChain(start.joints, liftCarryDescend(), 0.0, 1.0);
+TEST_F(TrajectoryChain, BlendedItIsFasterWithinTheLimitsAndStraightBelowTheFloor) {
+  const PlanResult stop = planner_.planChain(start_.joints, liftCarryDescend(), 0.0, 1.0);
   const double floor = 0.06;
-  const PlanResult r = planner.planChain(start.joints, liftCarryDescend(), floor, 1.0);
+  const PlanResult r = planner_.planChain(start_.joints, liftCarryDescend(), floor, 1.0);
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_LT(r.trajectory.duration(), stop.trajectory.duration() - 0.1);
   double velocity, acceleration, fd_velocity;
@@ -225,7 +229,7 @@ TEST(TrajectoryPlanner, BlendedChainIsFasterWithinTheLimitsAndAboveTheFloor) {
   // same start and end; where the gripper is below the floor it is on a move's own path: the
   // lift and the descent straight above their points
   for (std::size_t j = 0; j < kArmJoints; ++j) {
-    EXPECT_NEAR(r.trajectory.sample(0.0).q[j], start.joints[j], 1e-9);
+    EXPECT_NEAR(r.trajectory.sample(0.0).q[j], start_.joints[j], 1e-9);
     EXPECT_NEAR(r.trajectory.sample(r.trajectory.duration()).q[j], stop.trajectory.goal()[j], 1e-9);
   }
   for (double t = 0.0; t <= r.trajectory.duration(); t += 0.005) {
@@ -239,14 +243,10 @@ TEST(TrajectoryPlanner, BlendedChainIsFasterWithinTheLimitsAndAboveTheFloor) {
   }
 }
 
-TEST(TrajectoryPlanner, ChainNamesTheStepThatFails) {
-  IkSolver ik(testModel());
-  TrajectoryPlanner planner(testModel(), ik, nullptr);
-  const IkResult start = ik.solve(topDown(0.15, 0.25, 0.02, 0.3), JointVector{});
-  ASSERT_TRUE(start.ok());
+TEST_F(TrajectoryChain, ItNamesTheStepThatFails) {
   std::vector<ChainStep> steps = liftCarryDescend();
   steps[1].goal = topDown(2.0, 0.0, 0.10, 0.0);  // out of reach
-  const PlanResult r = planner.planChain(start.joints, steps, 0.07, 1.0);
+  const PlanResult r = planner_.planChain(start_.joints, steps, 0.07, 1.0);
   EXPECT_FALSE(r.ok());
   EXPECT_NE(r.message.find("move 2 of 3"), std::string::npos) << r.message;
 }

@@ -164,3 +164,14 @@ def test_a_pan_disturbed_during_the_carry_is_tared_with_the_sherd_clear_of_it(co
     assert zs[first_low + 1] == travel and at_scale[first_low + 1][4] is True
     assert zs[first_low + 2] < travel
     assert rec.sherds[1].mass == pytest.approx(0.02, abs=1e-6)  # the grain tared away
+
+
+def test_parking_with_the_fingers_low_around_a_sherd_goes_straight_up_first(config):
+    """A failure between setting a sherd down and the move that lifts away (Batch.lift_later)
+    parks the arm: straight up from the sherd before the way to the sleep pose."""
+    world = World(config, [])
+    batch = workflow.Batch(config, world.rig(), Recorder(), context="T")
+    batch.lift_later(0.23, -0.28, 0.5)
+    workflow.park(batch)
+    assert world.moves[-1] == (0.23, -0.28, config["arm"]["travel_z"], 0.5, True)
+    assert world.named == ["sleep"] and batch.lift_pending is None

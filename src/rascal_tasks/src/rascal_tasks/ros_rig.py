@@ -201,36 +201,32 @@ class RosArm(rig.Arm):
 
     def move_down(self, x, y, z, yaw, linear=False):
         pose = ControlArm.top_down(x, y, z, yaw)
+        motion = "linear" if linear else "joint"
+        return self._once_more(lambda: self._arm.move_to(pose, motion, self.speed_scale))
+
+    def move_through(self, steps, blend_above):
+        # once more (_once_more), every move of the chain: a lost trajectory left the arm at
+        # its start; after a stall part-way it goes back through the moves' own targets, each
+        # move collision-checked
+        poses = [ControlArm.top_down(x, y, z, yaw) for x, y, z, yaw, _linear in steps]
+        motions = ["linear" if step[4] else "joint" for step in steps]
+        return self._once_more(
+            lambda: self._arm.move_through(poses, motions, blend_above, self.speed_scale)
+        )
+
+    @staticmethod
+    def _once_more(send) -> float:
+        """`send()` a goal; the seconds it took. When the controller says the arm did not arrive
+        (a stalled or lost trajectory) the goal is sent once more from where the arm is; a
+        second timeout is a fault for a person to look at. A controller that did not answer at
+        all (no result) is one now."""
         for attempt in range(2):
             try:
-                return self._arm.move_to(
-                    pose, motion="linear" if linear else "joint", speed_scale=self.speed_scale
-                ).duration
+                return send().duration
             except Timeout as e:
-                # The controller says the arm did not arrive (a stalled or lost trajectory): send
-                # the goal once more from where it is; a second timeout is a fault for a person
-                # to look at. A controller that did not answer at all (no result) is one now.
                 if attempt or e.result is None:
                     raise _rig_error("arm", e) from None
                 rospy.logwarn("arm: %s; trying the move once more", e.message)
-            except ControlError as e:
-                raise _rig_error("arm", e) from None
-
-    def move_through(self, steps, blend_above):
-        poses = [ControlArm.top_down(x, y, z, yaw) for x, y, z, yaw, _linear in steps]
-        motions = ["linear" if step[4] else "joint" for step in steps]
-        for attempt in range(2):
-            try:
-                return self._arm.move_through(
-                    poses, motions, blend_above, speed_scale=self.speed_scale
-                ).duration
-            except Timeout as e:
-                # as move_down: once more from where the arm is, every move of the chain (a
-                # lost trajectory left the arm at the start; after a stall part-way, the arm
-                # goes back through the moves' own targets, each move collision-checked)
-                if attempt or e.result is None:
-                    raise _rig_error("arm", e) from None
-                rospy.logwarn("arm: %s; trying the moves once more", e.message)
             except ControlError as e:
                 raise _rig_error("arm", e) from None
 

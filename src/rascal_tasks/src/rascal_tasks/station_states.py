@@ -19,7 +19,8 @@ STACKED = 0.002
 
 
 class Translate(BatchState):
-    """Carry the sherd to a station at travel height; a drop on the way goes to RECOVER."""
+    """Carry the sherd to a station at travel height and, when the station is ready for it,
+    on down to where it is let go in the same motion; a drop on the way goes to RECOVER."""
 
     def __init__(self, batch, index):
         super().__init__(batch, ["arrived", "dropped"])
@@ -52,7 +53,8 @@ class Translate(BatchState):
 
 
 class Place(BatchState):
-    """Set the sherd down at the station's spot (or let it fall into the discard box)."""
+    """Set the sherd down at the station's spot (or let it fall into the discard box); the
+    carry may have lowered it there already (Translate)."""
 
     def __init__(self, batch, index):
         super().__init__(batch, ["placed"])
