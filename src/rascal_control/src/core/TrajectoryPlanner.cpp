@@ -21,9 +21,9 @@ constexpr double kBlendStep = 0.002;  // [s] blended overlaps are checked this o
 constexpr double kBlendFractions[] = {1.0,  0.95, 0.9,  0.85, 0.8,  0.75, 0.7,  0.65, 0.6, 0.55,
                                      0.5,  0.45, 0.4,  0.35, 0.3,  0.25, 0.2,  0.15, 0.1, 0.05};
 // Straight moves of a blended chain are planned at this fraction of the limits: the joints the
-// move next to them also drives keep some acceleration for it (at 1.0 a lift's braking elbow and
-// the carry's starting one add up past the limit, and only a tenth of the lift overlaps;
-// 0.9 lets the carry start about half-way up the lift: TrajectoryPlannerTest).
+// move next to them also drives keep some acceleration for it (TrajectoryPlannerTest's lift,
+// carry and descent blended above 0.05 m: at 1.0 the descent cannot start before the carry has
+// stopped, their accelerations adding past a joint's limit; at 0.9 it starts 0.3 s before).
 constexpr double kBlendedLinearScale = 0.9;
 
 std::string vectorText(const KDL::Vector& v) {
