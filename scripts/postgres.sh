@@ -2,7 +2,7 @@
 # Starts Debian's PostgreSQL 15 cluster and makes sure the `rascal` role and database exist.
 # Idempotent; used by setup.sh (tests, demo). On a field rig, point database.dsn in
 # config/rascal.yaml at the lab's server instead.
-#   scripts/postgres.sh start|stop|status
+#   scripts/postgres.sh start|stop|status|restart-if-running
 set -euo pipefail
 VER=15; CLUSTER=main
 PORT=${RASCAL_PG_PORT:-5432}
@@ -26,5 +26,12 @@ case "${1:-start}" in
     ;;
   stop) pg_ctlcluster --skip-systemctl-redirect "$VER" "$CLUSTER" stop ;;
   status) pg_lsclusters ;;
-  *) echo "usage: $0 start|stop|status" >&2; exit 2 ;;
+  restart-if-running)  # after apt upgraded the server: the running one still has the old binary
+    # and fails on the new libraries ("plpgsql.so: undefined symbol"); no systemd restarts it
+    if pg_lsclusters -h 2>/dev/null | awk -v v=$VER -v c=$CLUSTER '$1==v && $2==c {print $4}' \
+        | grep -q online; then
+      pg_ctlcluster --skip-systemctl-redirect "$VER" "$CLUSTER" restart
+    fi
+    ;;
+  *) echo "usage: $0 start|stop|status|restart-if-running" >&2; exit 2 ;;
 esac

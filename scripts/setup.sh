@@ -49,6 +49,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends "${APT_PACKAGES[@]}" >/dev/null
+  scripts/postgres.sh restart-if-running
 fi
 mkdir -p .setup
 

@@ -12,6 +12,7 @@ import time
 import pytest
 import yaml
 from rig_helpers import (
+    assert_masses_match,
     SCENARIOS,
     SMALL,
     ground_truth,
@@ -114,15 +115,6 @@ def _summary(recorded):
     return [(r["seq"], r["status"], r["lost_reason"], r["notes"]) for r in recorded]
 
 
-def _matches_truth(recorded, truth):
-    """Every recorded mass matches a different scenario sherd within 0.2 g."""
-    left = dict(truth)
-    for r in recorded:
-        name = min(left, key=lambda n: abs(left[n][2] * 1000 - r["mass_g"]))
-        assert abs(left[name][2] * 1000 - r["mass_g"]) < 0.2, (r["seq"], r["mass_g"], truth)
-        del left[name]
-
-
 def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
     rig = rig_factory(archive=tmp_path / "archive")
     truth = ground_truth(rig)
@@ -133,7 +125,7 @@ def test_injected_drop_is_recovered(rig_factory, db, tmp_path):
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
     # The slip shows up as a drop of a numbered sherd or as one more grasp before numbering.
     assert sum(r["drops"] for r in recorded) + sum(r["grasp_attempts"] for r in recorded) > 3
-    _matches_truth(recorded, truth)
+    assert_masses_match(recorded, truth)
 
 
 def _interrupt_when_weighed(rig, db, context, sig):
@@ -153,7 +145,7 @@ def _rerun_finishes_once_each(rig, db, context, truth):
     recorded = rows(db, context)
     assert [r["seq"] for r in recorded] == [1, 2, 3]
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
-    _matches_truth(recorded, truth)
+    assert_masses_match(recorded, truth)
 
 
 def test_killed_mid_batch_resumes_without_duplicates(rig_factory, db, tmp_path):
@@ -173,7 +165,7 @@ def test_touching_sherds_are_recorded_once_each(rig_factory, db, tmp_path):
     assert code == exit_codes.COMPLETE, out[-3000:]
     recorded = rows(db, "E2E-TOUCH")
     assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
-    _matches_truth(recorded, truth)
+    assert_masses_match(recorded, truth)
 
 
 def test_ctrl_c_parks_the_arm_and_a_rerun_finishes_the_batch(rig_factory, db, tmp_path):

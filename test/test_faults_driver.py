@@ -28,6 +28,7 @@ import time
 import pytest
 import yaml
 from rig_helpers import (
+    assert_masses_match,
     SMALL,
     WORKSPACE,
     ground_truth,
@@ -66,11 +67,7 @@ def rerun_finishes_once_each(rig, db, context, truth):
     why = "%s\n%s\nworld now: %s" % (summary(recorded), out[-3000:], ground_truth(rig))
     assert [r["seq"] for r in recorded] == [1, 2, 3], why
     assert [r["status"] for r in recorded] == ["done"] * 3, why
-    left = dict(truth)  # every row a different scenario sherd, its mass within 0.2 g
-    for r in recorded:
-        name = min(left, key=lambda n: abs(left[n][2] * 1000 - r["mass_g"]))
-        assert abs(left[name][2] * 1000 - r["mass_g"]) < 0.2, (r["seq"], r["mass_g"], truth)
-        del left[name]
+    assert_masses_match(recorded, truth)
     return out
 
 

@@ -15,6 +15,7 @@ import psycopg2
 import pytest
 import yaml
 from rig_helpers import (
+    assert_masses_match,
     SMALL,
     WORKSPACE,
     block_database,
@@ -67,11 +68,7 @@ def assert_each_sherd_once(recorded, truth):
     unfinished, each mass within 0.2 g of a different sherd's true mass."""
     assert [r["seq"] for r in recorded] == list(range(1, len(truth) + 1)), _statuses(recorded)
     assert all(r["status"] == "done" for r in recorded), _statuses(recorded)
-    left = dict(truth)
-    for r in recorded:
-        name = min(left, key=lambda n: abs(left[n][2] * 1000 - r["mass_g"]))
-        assert abs(left[name][2] * 1000 - r["mass_g"]) < 0.2, (r["seq"], r["mass_g"], truth)
-        del left[name]
+    assert_masses_match(recorded, truth)
 
 
 def assert_no_sherd_twice(recorded, truth, code):
@@ -83,13 +80,7 @@ def assert_no_sherd_twice(recorded, truth, code):
     assert len(recorded) == len(truth), summary
     assert [r["seq"] for r in recorded] == list(range(1, len(truth) + 1)), summary
     assert all(r["status"] in ("done", "lost") for r in recorded), summary
-    left = dict(truth)
-    for r in sorted(recorded, key=lambda r: r["mass_g"] is None):
-        if r["mass_g"] is None:
-            continue
-        name = min(left, key=lambda n: abs(left[n][2] * 1000 - r["mass_g"]))
-        assert abs(left[name][2] * 1000 - r["mass_g"]) < 0.2, (r["seq"], r["mass_g"], truth)
-        del left[name]
+    assert_masses_match(recorded, truth)
     complete = all(r["status"] == "done" for r in recorded)
     assert code == (0 if complete else 1), (code, summary)
 
