@@ -73,6 +73,7 @@ class Place(BatchState):
         if lowered and not plugin.ready_for_place(s):
             # no longer ready (the scale's pan moved since its tare): back up, for the station
             # to get ready with the sherd well clear of it
+            b.log("sherd %s: the %s not ready on the arrival: backed up" % (s.seq, st.name))
             b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
             lowered = False
         plugin.before_place(s)

@@ -131,6 +131,19 @@ def settled(readings: List[ScaleReading], window: float, readability: float):
     return ScaleReading(round(sum(masses) / len(masses), 7), True, last.stamp)
 
 
+def reads_zero(readings: List[ScaleReading], window: float, readability: float) -> bool:
+    """The tare check's rule, on the `readings` since a tare (oldest first): they span a whole
+    `window`, every one reads zero within `readability` (the last digit either way: a tared
+    empty pan's own noise flips it, so `settled`'s spread of one digit would refuse a good
+    tare about one window in seven), and the scale calls the last one stable. A pan still
+    swinging when it was tared drifts off zero by more than the digit and fails it."""
+    if not readings or not readings[-1].stable:
+        return False
+    if readings[-1].stamp - readings[0].stamp < window - _STAMP_SLACK:
+        return False
+    return all(abs(r.mass) <= readability + 1e-9 for r in readings)
+
+
 @station_type("scale")
 class ScaleStation(StationPlugin):
     """Weighs the sherd. A mass is recorded only when the reading held within the scale's
@@ -211,7 +224,14 @@ class ScaleStation(StationPlugin):
         if self._early_tare is not None:
             return False
         b, cfg = self.batch, self._cfg()
-        empty = self._settled_now(b.rig.clock.now() - cfg["stable_window"] - 1.0)
+        # steady within the last digit either way (the empty pan's noise flips it both ways
+        # about one window in seven): a pan still moving when tared is caught by the check
+        # after the tare (reads_zero), which allows no more
+        empty = settled(
+            b.rig.scale.readings(b.rig.clock.now() - cfg["stable_window"] - 1.0),
+            cfg["stable_window"],
+            2 * cfg["readability"],
+        )
         if empty is None:
             return False
         if empty.mass >= MIN_SHERD_MASS:
@@ -275,23 +295,32 @@ class ScaleStation(StationPlugin):
         early, self._early_tare = self._early_tare, None
         if early is None:
             return False
-        zero = self._settled_now(early[0])
-        if zero is None:
-            self.batch.log(
-                "sherd %d: the pan not steady for a window since the tare made while away: "
-                "tared again above the scale" % sherd.seq
-            )
-            return False
-        if abs(zero.mass) > self._cfg()["readability"] + 1e-9:
+        if self._zero_since(early[0], whole_window=True):
+            self._before_tare = early[1]
+            return True
+        off = self._settled_now(early[0])
+        if off is not None and abs(off.mass) > self._cfg()["readability"] + 1e-9:
             self.batch.event(
                 sherd,
                 "tare_failed",
                 "the tare made while away: the empty platform reads %.1f g after it; tared "
-                "again above the scale" % (zero.mass * 1000),
+                "again above the scale" % (off.mass * 1000),
             )
-            return False
-        self._before_tare = early[1]
-        return True
+        else:
+            self.batch.log(
+                "sherd %d: the pan not at zero for a window since the tare made while away: "
+                "tared again above the scale" % sherd.seq
+            )
+        return False
+
+    def _zero_since(self, tared_at: float, whole_window: bool) -> bool:
+        """Whether every reading since the tare at `tared_at` is zero within the readability;
+        with `whole_window`, also for a whole window, the last stable (`reads_zero`)."""
+        readings = self.batch.rig.scale.readings(tared_at)
+        readability = self._cfg()["readability"]
+        if whole_window:
+            return reads_zero(readings, self._cfg()["stable_window"], readability)
+        return all(abs(r.mass) <= readability + 1e-9 for r in readings)
 
     def _tare_once(self) -> Optional[str]:
         """Tare after a settled empty reading, then check it; None when it took, else why not."""
@@ -310,18 +339,25 @@ class ScaleStation(StationPlugin):
         return None
 
     def ready_for_place(self, sherd, by_arrival=False):
-        """Only with the tare made while away holding (the pan steady at zero for a window): a
-        tare made now needs the sherd well clear of the pan, the arm above it. By the arrival:
-        that tare made, and every reading since it zero so far."""
+        """Only with the tare made while away holding (the pan at zero for a window): a tare
+        made now needs the sherd well clear of the pan, the arm above it. By the arrival: that
+        tare made, and every reading since it zero so far. On the arrival, a carry quicker than
+        a window since the tare waits out the rest of it where it is (a sherd touching the pan
+        would read), until the tare is stable_timeout old at most."""
         early = self._early_tare
         if early is None:
             return False
-        readability = self._cfg()["readability"] + 1e-9
         if by_arrival:
-            since = self.batch.rig.scale.readings(early[0])
-            return all(abs(r.mass) <= readability for r in since)
-        zero = self._settled_now(early[0])
-        return zero is not None and abs(zero.mass) <= readability
+            return self._zero_since(early[0], whole_window=False)
+        clock = self.batch.rig.clock
+        while not self._zero_since(early[0], whole_window=True):
+            if not self._zero_since(early[0], whole_window=False):
+                return False  # off zero: tared again, the sherd clear of the pan
+            if clock.now() >= early[0] + self._cfg()["stable_timeout"]:
+                return False
+            self.batch.check_stop()
+            clock.sleep(SCALE_POLL)
+        return True
 
     def before_place(self, sherd):
         self._tared_for = None
