@@ -27,18 +27,21 @@ def test_the_shutter_sees_no_arm_and_the_fingers_are_open_around_the_sherd_by_th
     cam, standby, travel = _poses(config)
     assert len(world.at_shutter) == 2
     assert all(_at_standby(at, standby, travel) for at in world.at_shutter)
-    # while the image is transferred: over the sherd, then straight down to its grasp height
+    # while the image is transferred: over the sherd, straight down to its grasp height, and
+    # (only the discard box after it: nothing else works on it there) picked up, straight up
+    # to travel height, where it waits for the photo
     for moves in world.transfer_moves:
-        over, down = moves
+        over, down, lift = moves
         assert over[:2] == pytest.approx(tuple(cam.place_at)) and not over[4]
         assert down[:2] == pytest.approx(tuple(cam.place_at)) and down[4]
         assert cam.surface_z < down[2] < over[2] < travel
-    # the next move after each transfer is the lift of the picked-up sherd: REPICK only closed
+        assert lift[:2] == pytest.approx(tuple(cam.place_at)) and lift[2] == travel and lift[4]
+    # once the photo is in, the next move carries it on to the discard box: REPICK did nothing
+    box = config.stations["discard"]
     for k, m in enumerate(world.moves):
         if _at_standby(m, standby, travel):
-            lift = world.moves[k + 3]
-            assert lift[:2] == pytest.approx(tuple(cam.place_at)) and lift[2] == travel
-            assert lift[4]
+            assert world.moves[k + 4][:2] == pytest.approx(tuple(box.place_at))
+    assert {s.station for s in world.sherds} == {"discard"}
 
 
 def test_a_transfer_that_fails_is_shot_again_from_standby_after_lifting_straight_up(config):
@@ -57,6 +60,10 @@ def test_a_transfer_that_fails_is_shot_again_from_standby_after_lifting_straight
     )
     lift = world.moves[second - 1]
     assert lift[:2] == pytest.approx(tuple(cam.place_at)) and lift[2] == travel and lift[4]
+    # it had been picked up during the lost transfer: set down again for the second shutter
+    down_again = world.moves[second - 2]
+    assert down_again[:2] == pytest.approx(tuple(cam.place_at)) and down_again[2] < travel
+    assert world.in_view_at_shutter == [["a"], ["a"]]
 
 
 def test_a_clipped_photo_is_retaken_from_standby_too(config, tmp_path):

@@ -46,10 +46,12 @@ def test_the_way_back_during_the_transfer_reaches_the_sherd_on_the_platform(conf
     outcome, _batch, rec = run_batch(config, world)
     assert outcome == "finished" and rec.status() == {1: "done"}
     scale = config.stations["scale"]
-    (over, down) = world.transfer_moves[0]
+    (over, down, lift) = world.transfer_moves[0]
     assert over[:2] == pytest.approx(scale.place_at) and down[:2] == pytest.approx(scale.place_at)
     # fingers at the sherd's grasp height on the platform, not on the table under the camera
     assert scale.surface_z < down[2] < over[2] < config["arm"]["travel_z"]
+    # picked up off the platform while the photo still transfers: waits at travel height
+    assert lift[:2] == pytest.approx(scale.place_at) and lift[2] == config["arm"]["travel_z"]
 
 
 def test_a_restart_with_a_weighed_sherd_on_the_scale_photographs_it_there(config):

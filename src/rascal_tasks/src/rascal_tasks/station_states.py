@@ -168,7 +168,12 @@ def repick(b, index) -> bool:
     first (where it was placed, as it was held), then from a fresh look on each miss. False,
     with the sherd recorded lost, when it could not be taken."""
     s = b.sherd
-    st = b.plugins[index].lies_at
+    plugin = b.plugins[index]
+    st = plugin.lies_at
+    if plugin.held_up:  # picked up while the station waited (the camera's transfer)
+        plugin.held_up = False
+        if b.rig.gripper.holding():
+            return True
     x, y = s.last_xy
     o = placed_observation(b, s, st)
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):

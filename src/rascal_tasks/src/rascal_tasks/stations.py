@@ -58,6 +58,9 @@ class StationPlugin:
         # the station the sherd lies on while this one works: this one, or the scale for a
         # camera over it (`over_scale`: Batch sets it), where the sherd stays
         self.lies_at = station
+        # the sherd was picked up off `lies_at` while this station waited (the camera's
+        # transfer) and is held at travel height above it: REPICK has nothing to do
+        self.held_up = False
 
     @property
     def stays(self) -> bool:
@@ -529,13 +532,46 @@ class ArchivalCameraStation(StationPlugin):
         self._made_way = True
 
     def _reach_back(self, sherd):
+        """During the transfer: the fingers open around the sherd; and when no later station
+        works on it here, it is picked up too (REPICK's grasp, the lift checked), to wait at
+        travel height above its spot for the photo: carried on only once the photo is in
+        (a retake sets it down again first). The transfer's 1.5 s cover the way back, the
+        close and the lift (timing.md)."""
         self.at_sherd = True
         self.reach_back(sherd)
+        b = self.batch
+        i = b.plugins.index(self)
+        if i + 1 < len(b.plugins) and b.next_stays(i) is None:
+            # imported here: manipulation -> survey -> batch imports this module
+            from rascal_tasks.manipulation import grasp, placed_observation
+
+            self.at_sherd = False  # lifted, held or not: the arm is at travel height
+            self.held_up = grasp(b, placed_observation(b, sherd, self.lies_at), self.lies_at)
+
+    def _set_down_again(self, sherd):
+        """The sherd held up during the transfer goes back onto its spot (a retake, a failed
+        transfer): lowered, let go, the fingers left around it (`_standby` lifts first)."""
+        # imported here: station_states and manipulation import this module
+        from rascal_tasks.manipulation import release
+        from rascal_tasks.station_states import place_z
+
+        b = self.batch
+        self.held_up = False
+        if not b.rig.gripper.holding():
+            return  # it slipped out above its spot: REPICK looks for it there
+        x, y = sherd.last_xy
+        b.move_down(x, y, place_z(b, self.lies_at, sherd), sherd.grasp_yaw, linear=True)
+        with b.phase("grasping"):
+            sherd.width = release(b, sherd.width)
+        self.at_sherd = True
 
     def _standby(self, sherd):
         """Out of the camera's view, the wrist camera facing away too (the sherd was set down
-        turned so); from the sherd (a retake, a failed transfer) straight up first."""
+        turned so); from the sherd (a retake, a failed transfer) straight up first, a sherd
+        held up during the transfer set down again before."""
         b = self.batch
+        if self.held_up:
+            self._set_down_again(sherd)
         if self.at_sherd:
             x, y = sherd.last_xy
             b.lift_later(x, y, sherd.grasp_yaw)  # up and away as one motion
