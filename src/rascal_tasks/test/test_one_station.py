@@ -3,6 +3,7 @@ the archival camera, so a sherd is set down once, weighed, photographed where it
 picked up from the scale for the discard box (batch tier, on the in-memory rig)."""
 
 import pytest
+import fake_rig
 from fake_rig import Recorder, Sherd, World, run_batch, shipped_config
 
 from rascal_tasks import workflow
@@ -177,3 +178,50 @@ def test_parking_with_the_fingers_low_around_a_sherd_goes_straight_up_first(conf
     workflow.park(batch)
     assert world.moves[-1] == (0.23, -0.28, config["arm"]["travel_z"], 0.5, True)
     assert world.named == ["sleep"] and batch.lift_pending is None
+
+
+def _spy_shutters(monkeypatch, rec):
+    """Each capture's sherd masses (seq -> kg or None) as its shutter fires."""
+    shots = []
+    real = fake_rig._Camera.capture_while
+
+    def spy(camera, path, exposure_ev, during):
+        shots.append({seq: r.mass for seq, r in rec.sherds.items()})
+        return real(camera, path, exposure_ev, during)
+
+    monkeypatch.setattr(fake_rig._Camera, "capture_while", spy)
+    return shots
+
+
+def test_the_photo_is_shot_while_the_scale_settles_and_the_sherd_taken_up_once_weighed(
+    config, monkeypatch
+):
+    """The camera over the scale fires as soon as the arm is at standby, before the pan's
+    reading has held for a window: the sherd is weighed during the transfer, then taken up."""
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    world.scale_settle = 1.5  # readings unsteady this long after the sherd lands
+    rec = Recorder()
+    shots = _spy_shutters(monkeypatch, rec)
+    outcome, _batch, rec = run_batch(config, world, rec)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    assert shots == [{1: None}]  # no mass yet at the shutter
+    assert rec.sherds[1].mass == pytest.approx(0.02) and rec.sherds[1].image
+    _over, _down, lift = world.transfer_moves[0]  # weighed, then taken up in the transfer
+    assert lift[2] == config["arm"]["travel_z"]
+
+
+def test_two_on_the_pan_keep_no_photo_and_are_not_taken_up_during_the_transfer(config, monkeypatch):
+    """Two sherds lifted as one weigh too much: the photo shot meanwhile is not theirs to
+    keep, the arm stays at standby through the transfer, and both are put back (PutBack)."""
+    world = World(
+        config,
+        [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.29), Sherd("c", 0.20, 0.21, mass=0.015)],
+    )
+    world.doubles = {"a": "b"}
+    rec = Recorder()
+    shots = _spy_shutters(monkeypatch, rec)
+    outcome, _batch, rec = run_batch(config, world, rec)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done", 3: "done"}
+    assert sorted(round(r.mass, 4) for r in rec.sherds.values()) == [0.015, 0.02, 0.02]
+    assert len(shots) == 4  # the pair's, then one for each sherd
+    assert world.transfer_moves[0] == []  # the pair's transfer: the arm stayed at standby

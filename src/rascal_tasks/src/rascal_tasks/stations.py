@@ -392,6 +392,19 @@ class ScaleStation(StationPlugin):
             )
 
     def after_place(self, sherd):
+        b = self.batch
+        since = b.rig.clock.now()
+        after = b.next_stays(b.plugins.index(self))
+        shoot = getattr(after, "shoot_while", None)
+        if shoot is None:
+            return self._weigh(sherd, since)
+        # the camera over the scale: its shutter needs the arm out of view (it went to standby
+        # as the sherd was set down), not a settled pan: it fires first, the pan settles during
+        # the image's transfer
+        return shoot(sherd, lambda: self._weigh(sherd, since))
+
+    def _weigh(self, sherd, since: float) -> str:
+        """after_place's weighing, on the readings from `since` (the sherd set down) on."""
         b, cfg = self.batch, self._cfg()
         if self._tared_for != sherd.seq:
             if sherd.status == "mass_unstable":
@@ -399,7 +412,6 @@ class ScaleStation(StationPlugin):
             # after a restart, found lying on the scale: the run before tared and checked it
             b.event(sherd, "tare_unchecked", "lying on the scale after a restart")
         reading = last = None
-        since = b.rig.clock.now()
         with b.phase("data_collection"):
             for attempt in range(1 + cfg["rereads"]):
                 reading, last = self._settle(since)
@@ -477,15 +489,20 @@ class ArchivalCameraStation(StationPlugin):
         self.exposure = Exposure()
         self.at_sherd = False  # the arm reached back for the sherd during a capture
         self._made_way = False  # the arm went to standby as the sherd was set down (make_way)
+        self._early = None  # (capture or None) of `shoot_while`, for after_place
 
     def after_place(self, sherd):
         b = self.batch
-        # placing lifted the arm to travel height, or (on the scale) took it to standby; after
-        # a restart it may be anywhere above the sherd on the scale: straight up first
-        self.at_sherd = self.stays and not self._made_way
+        early, self._early = self._early, None
+        if early is None:
+            # placing lifted the arm to travel height, or (on the scale) took it to standby;
+            # after a restart it may be anywhere above the sherd on the scale: straight up first
+            self.at_sherd = self.stays and not self._made_way
         self._made_way = False
         with b.phase("data_collection"):
-            capture = self._capture(sherd, sherd.spool_path())
+            capture = early[0] if early is not None else None
+            if capture is None:
+                capture = self._capture(sherd, sherd.spool_path())
             if capture is None:
                 return "failed"  # it lies on the camera's spot: the batch stops
             while True:
@@ -524,6 +541,41 @@ class ArchivalCameraStation(StationPlugin):
                 b.rig.clock.sleep(1.0)
         self._standby(sherd)
         return None
+
+    def shoot_while(self, sherd, weigh) -> str:
+        """Over the scale: the photo shot as soon as the sherd is set down and the arm at
+        standby, `weigh()` (the scale's after_place, its outcome returned) run during the
+        image's transfer; then, weighed ('done'), the arm goes back for the sherd and takes it
+        up (`_reach_back`). The capture is kept for after_place, which checks its exposure
+        (a retake sets the sherd down again); one that failed is taken again there. Refused
+        before the shutter: weighed as before, the photo taken after."""
+        b = self.batch
+        outcome, raised = [], []
+
+        def during():
+            try:
+                outcome.append(weigh())
+                if outcome[0] == "done":
+                    self._reach_back(sherd)
+            except BaseException:
+                raised.append(True)  # the scale's or the arm's failure, not the camera's
+                raise
+
+        capture = None
+        with b.phase("data_collection"):
+            try:
+                capture = b.rig.camera.capture_while(sherd.spool_path(), self.exposure.ev, during)
+            except RigError as e:
+                if raised:
+                    raise
+                b.event(sherd, "capture_failed", "while weighing: %s" % e.reason)
+        if not outcome:  # refused before the shutter: nothing ran
+            return weigh()
+        if outcome[0] == "done":
+            self._early = (capture,)
+        elif capture is not None:
+            _discard(capture.path)  # not this sherd's photo: two sherds, or none, on the pan
+        return outcome[0]
 
     def make_way(self, sherd):
         """Out of view while the scale under the camera settles: the shutter needs no move."""
