@@ -82,8 +82,29 @@ def test_a_wait_run_on_during_the_next_moves_is_waited_only_past_them():
         return lb.timed(steps, ik1, [0.0] * 6)[1]
 
     moves = 2 * lb.move_time([0.0] * 6, [0.5] + [0.0] * 5)
-    assert waits(moves + 0.7) == pytest.approx(0.7 + 0.2)
+    # what is left of it overlaps the shutter at standby: the longer of the two is waited
+    assert waits(moves + 0.7) == pytest.approx(0.7)
+    assert waits(moves + 0.1) == pytest.approx(0.2)
     assert waits(moves / 2) == pytest.approx(0.2)
+
+
+def test_a_transfer_is_made_during_the_next_moves_and_their_waits():
+    def ik1(x, y, z, seed):
+        return [x, 0.0, 0.0, 0.0, 0.0, 0.0]
+
+    def serial(transfer):  # standby, then back over the sherd, down (a close), up
+        steps = [
+            lb.Step("standby", (0.0, 0, 0), wait=0.2, serial_wait=transfer, overlaps_next=3),
+            lb.Step("back over", (0.5, 0, 0)),
+            lb.Step("down", (1.0, 0, 0), wait=0.1),
+            lb.Step("up", (0.5, 0, 0)),
+            lb.Step("on", (0.0, 0, 0)),
+        ]
+        return lb.timed(steps, ik1, [0.0] * 6)[2]
+
+    three = 3 * lb.move_time([0.0] * 6, [0.5] + [0.0] * 5)
+    assert serial(three + 0.1 + 0.4) == pytest.approx(0.4)  # only its excess is waited
+    assert serial(three / 2) == pytest.approx(0.0)
 
 
 def test_one_station_bound_is_below_the_separate_stations(data):

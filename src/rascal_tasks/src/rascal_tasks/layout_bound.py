@@ -9,15 +9,16 @@ grasp); the gripper's strokes only as wide as the grasp margin; the stations' ow
 simulator's models (the scale's settling, the camera's shutter and transfer). Two figures:
 
 - `serial`: that sequence with the waits as the workflow runs them today (the shutter with
-  the arm at standby, the transfer overlapped only by the way back over the sherd,
-  `ArchivalCameraStation`; the tare is done while the arm is at the later stations,
+  the arm at standby, the transfer overlapped by the way back over the sherd, the grasp and
+  the lift, `ArchivalCameraStation`; the tare is done while the arm is at the later stations,
   `ScaleStation.while_away`);
 - `bound`: the same moves with only what cannot overlap arm motion (the loaded scale settling
   while the arm hovers, the shutter): no planner margin, no transfer wait.
 
 With the camera over the scale (`over_scale`, the one-station layout) the sherd is set down
-once: the scale settles while the arm lifts and goes to standby, the shutter, the way back
-during the transfer, the grasp for the discard box.
+once: the scale settles while the arm lifts and goes to standby and while the shutter is open
+(ArchivalCameraStation.shoot_while), then the way back, the grasp and the lift for the
+discard box during the transfer.
 
 Moves the workflow makes as one motion (`Batch.move_through`, with arm.blend_z > 0: the carry
 and the descent at a station, the lift from the scale and the way to standby)
@@ -64,8 +65,10 @@ class Step:
     pose: Tuple[float, float, float]  # x, y, z of ee_gripper_link [m]
     wait: float = 0.0  # [s] after arriving (gripper stroke, station) in the bound
     serial_wait: float = 0.0  # [s] more as the workflow runs today: in series, but for...
-    overlaps_next: bool = False  # ...the next move, made meanwhile
-    wait_during: int = 0  # `wait` runs on during this many next moves: only its excess counts
+    overlaps_next: int = 0  # ...this many next moves (and their waits), made meanwhile
+    # `wait` runs on during this many next moves: only its excess over them counts, and that
+    # excess overlaps the wait of the step they end at (the shutter while the scale settles)
+    wait_during: int = 0
     blends: bool = False  # one motion with the step before (which then has no wait of its own)
 
 
@@ -121,7 +124,7 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
                     (sx, sy, travel),
                     wait=SHUTTER,
                     serial_wait=TRANSFER,
-                    overlaps_next=True,
+                    overlaps_next=3,  # back over it, down, taken up (ArchivalCameraStation)
                     blends=blend and st.over_scale,  # up from the scale and away, one motion
                 )
             )
@@ -166,25 +169,31 @@ def survey_steps(cfg: Config) -> List[Step]:
 def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, list]:
     """(motion, bound waits, serial waits, last joints) of `steps` from the joints `start`."""
     q, motion, waits, serial = start, 0.0, 0.0, 0.0
-    overlapping = 0.0  # a serial wait the next move is made during
+    overlapping, over_left = 0.0, 0  # a serial wait the next moves are made during
     running, moves_left = 0.0, 0  # a wait the next moves are made during (Step.wait_during)
     for s in merged(steps):
         q1 = ik(*s.pose, q)
         move = move_time(q, q1)
         motion += move
-        serial += max(0.0, overlapping - move)
+        own_wait = 0.0 if s.wait_during else s.wait
+        if over_left:
+            overlapping, over_left = max(0.0, overlapping - move - own_wait), over_left - 1
+            if not over_left:
+                serial += overlapping  # what is left of it is waited here
         if moves_left:
             running, moves_left = max(0.0, running - move), moves_left - 1
-            if not moves_left:
-                waits += running  # what is left of it is waited here
+            if not moves_left:  # what is left of it is waited here, with this step's own
+                waits += max(running, own_wait)
+                own_wait = 0.0
         if s.wait_during:
             running, moves_left = s.wait, s.wait_during
+        waits += own_wait
+        if s.overlaps_next:
+            overlapping, over_left = s.serial_wait, s.overlaps_next
         else:
-            waits += s.wait
-        overlapping = s.serial_wait if s.overlaps_next else 0.0
-        serial += 0.0 if s.overlaps_next else s.serial_wait
+            serial += s.serial_wait
         q = q1
-    return motion, waits, serial + overlapping, q
+    return motion, waits, serial + (overlapping if over_left else 0.0), q
 
 
 def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str, float]:
