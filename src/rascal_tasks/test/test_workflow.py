@@ -15,7 +15,7 @@ from rascal_tasks.selection import in_pick_order
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import PUSH, push_direction
 from rascal_tasks.station_states import AtStation
-from rascal_tasks.config import Rect, config_from_dict
+from rascal_tasks.config import Rect, config_from_dict, merged
 from rascal_tasks.survey import NextSherd, lawnmower, merge, on_the_mat
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
@@ -258,6 +258,18 @@ def test_a_sherd_in_the_fingers_after_a_restart_is_set_down_and_carried_on(data)
     # weighed already: picked up again and carried to the next station (the camera)
     assert Resume(batch).run() == "TRANSLATE_1"
     assert batch.sherd.seq == 2 and batch.sherd.station_index == 0
+
+
+def test_a_weighed_sherd_in_the_fingers_goes_back_onto_the_scale_under_the_camera(data):
+    """One station: a sherd weighed and taken up during the photo's transfer, in the fingers
+    when the run was killed, is carried back onto the scale (weighed again there) for the
+    camera over it: never set down at the camera's spot as a station of its own."""
+    with open(os.path.join(WORKSPACE, "config", "layouts", "one_station.yaml")) as f:
+        one = merged(data, yaml.safe_load(f))
+    batch = _restarted_batch(one, {"pickup": [_obs(0.151, 0.221, 0.05, 0.04)]})
+    assert Home(batch).run() == "done" and batch.put_back == (2, 0.15, 0.22)
+    assert Resume(batch).run() == "TRANSLATE_0"
+    assert batch.sherd.seq == 2
 
 
 def test_an_empty_gripper_after_a_restart_is_only_opened(data):

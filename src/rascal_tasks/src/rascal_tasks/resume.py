@@ -199,11 +199,16 @@ class Resume(BatchState):
             for o in survey_at(b, b.pickup, x, y)
             if o.distance_to(x, y) < b.config["recovery"]["search_radius"]
         ]
+        # a camera over the scale works where the scale set the sherd down: it goes back onto
+        # the scale (weighed again), not to the camera's spot as a station of its own
+        to = done + 1
+        while 0 < to < len(b.plugins) and b.plugins[to].stays:
+            to -= 1
         for o in sorted(near, key=lambda o: o.distance_to(x, y))[:1]:
             if grasp(b, o, b.pickup):
                 s.seen(o, b.pickup)
                 s.picked_xy = (o.x, o.y)
-                s.station_done(done)
-                return "TRANSLATE_%d" % (done + 1)
+                s.station_done(to - 1)
+                return "TRANSLATE_%d" % to
         s.lose("set down at its pickup spot after restart, not picked up again")
         return "SURVEY"
