@@ -82,10 +82,21 @@ def test_a_wait_run_on_during_the_next_moves_is_waited_only_past_them():
         return lb.timed(steps, ik1, [0.0] * 6)[1]
 
     moves = 2 * lb.move_time([0.0] * 6, [0.5] + [0.0] * 5)
-    # what is left of it overlaps the shutter at standby: the longer of the two is waited
-    assert waits(moves + 0.7) == pytest.approx(0.7)
-    assert waits(moves + 0.1) == pytest.approx(0.2)
+    assert waits(moves + 0.7) == pytest.approx(0.7 + 0.2)
     assert waits(moves / 2) == pytest.approx(0.2)
+
+    def through_the_shutter(wait):  # on through the shutter and the way back down
+        steps = [
+            lb.Step("settles", (0.0, 0, 0), wait=wait, wait_during=3),
+            lb.Step("standby", (0.5, 0, 0), wait=0.2),
+            lb.Step("back", (0.0, 0, 0)),
+            lb.Step("down", (0.5, 0, 0), wait=0.1),  # the close: after it has settled
+        ]
+        return lb.timed(steps, ik1, [0.0] * 6)[1]
+
+    three = 3 * lb.move_time([0.0] * 6, [0.5] + [0.0] * 5)
+    assert through_the_shutter(three + 0.2 + 0.4) == pytest.approx(0.2 + 0.4 + 0.1)
+    assert through_the_shutter(three / 2) == pytest.approx(0.2 + 0.1)
 
 
 def test_a_transfer_is_made_during_the_next_moves_and_their_waits():

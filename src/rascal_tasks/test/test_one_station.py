@@ -8,6 +8,7 @@ from fake_rig import Recorder, Sherd, World, run_batch, shipped_config
 
 from rascal_tasks import workflow
 from rascal_tasks.layout_bound import sequence
+from rascal_tasks.stations import ScaleStation
 
 LAYOUT = "config/layouts/one_station.yaml"
 
@@ -197,14 +198,27 @@ def test_the_photo_is_shot_while_the_scale_settles_and_the_sherd_taken_up_once_w
     config, monkeypatch
 ):
     """The camera over the scale fires as soon as the arm is at standby, before the pan's
-    reading has held for a window: the sherd is weighed during the transfer, then taken up."""
+    reading has held for a window: the fingers go round the sherd and it is weighed during the
+    transfer, then taken up."""
     world = World(config, [Sherd("a", 0.10, 0.22)])
     world.scale_settle = 1.5  # readings unsteady this long after the sherd lands
     rec = Recorder()
     shots = _spy_shutters(monkeypatch, rec)
+    weighs = []  # the arm's moves made by the time the weighing starts
+    weigh = ScaleStation._weigh
+    monkeypatch.setattr(
+        ScaleStation,
+        "_weigh",
+        lambda station, sherd, since: (
+            weighs.append(list(world.moves)),
+            weigh(station, sherd, since),
+        )[1],
+    )
     outcome, _batch, rec = run_batch(config, world, rec)
     assert outcome == "finished" and rec.status() == {1: "done"}
     assert shots == [{1: None}]  # no mass yet at the shutter
+    over, down, _lift = world.transfer_moves[0]
+    assert weighs[0][-2:] == [over, down]  # the fingers round it while the pan settles
     assert rec.sherds[1].mass == pytest.approx(0.02) and rec.sherds[1].image
     _over, _down, lift = world.transfer_moves[0]  # weighed, then taken up in the transfer
     assert lift[2] == config["arm"]["travel_z"]
@@ -212,7 +226,7 @@ def test_the_photo_is_shot_while_the_scale_settles_and_the_sherd_taken_up_once_w
 
 def test_two_on_the_pan_keep_no_photo_and_are_not_taken_up_during_the_transfer(config, monkeypatch):
     """Two sherds lifted as one weigh too much: the photo shot meanwhile is not theirs to
-    keep, the arm stays at standby through the transfer, and both are put back (PutBack)."""
+    keep, the arm does not take them up during the transfer, and both are put back (PutBack)."""
     world = World(
         config,
         [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.29), Sherd("c", 0.20, 0.21, mass=0.015)],
@@ -224,4 +238,8 @@ def test_two_on_the_pan_keep_no_photo_and_are_not_taken_up_during_the_transfer(c
     assert outcome == "finished" and rec.status() == {1: "done", 2: "done", 3: "done"}
     assert sorted(round(r.mass, 4) for r in rec.sherds.values()) == [0.015, 0.02, 0.02]
     assert len(shots) == 4  # the pair's, then one for each sherd
-    assert world.transfer_moves[0] == []  # the pair's transfer: the arm stayed at standby
+    # the pair's transfer: the fingers went round them while the pan settled, then straight
+    # up without closing (PUT_BACK picks them up)
+    over, down, up = world.transfer_moves[0]
+    assert down[2] < over[2] and up[:2] == down[:2] and up[2] == config["arm"]["travel_z"]
+    assert up[4]

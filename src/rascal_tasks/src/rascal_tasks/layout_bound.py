@@ -16,9 +16,9 @@ simulator's models (the scale's settling, the camera's shutter and transfer). Tw
   while the arm hovers, the shutter): no planner margin, no transfer wait.
 
 With the camera over the scale (`over_scale`, the one-station layout) the sherd is set down
-once: the scale settles while the arm lifts and goes to standby and while the shutter is open
-(ArchivalCameraStation.shoot_while), then the way back, the grasp and the lift for the
-discard box during the transfer.
+once: the scale settles while the arm lifts and goes to standby, the shutter, and the way back
+down round the sherd (ArchivalCameraStation.shoot_while); then the grasp and the lift for the
+discard box, all during the transfer.
 
 Moves the workflow makes as one motion (`Batch.move_through`, with arm.blend_z > 0: the carry
 and the descent at a station, the lift from the scale and the way to standby)
@@ -66,8 +66,8 @@ class Step:
     wait: float = 0.0  # [s] after arriving (gripper stroke, station) in the bound
     serial_wait: float = 0.0  # [s] more as the workflow runs today: in series, but for...
     overlaps_next: int = 0  # ...this many next moves (and their waits), made meanwhile
-    # `wait` runs on during this many next moves: only its excess over them counts, and that
-    # excess overlaps the wait of the step they end at (the shutter while the scale settles)
+    # `wait` runs on during this many next moves (and the waits between them: the shutter
+    # while the scale settles): only its excess over them counts
     wait_during: int = 0
     blends: bool = False  # one motion with the step before (which then has no wait of its own)
 
@@ -108,8 +108,9 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
             settle = scale_settle(TYPICAL_MASS, scale["stable_window"], scale["readability"])
             if after is not None and cfg.stations[after].over_scale:
                 # it settles while the arm goes up and out of the camera's view (make_way:
-                # one motion, or two)
-                moves = 1 if blend else 2
+                # one motion, or two), the shutter, and the way back down round the sherd
+                # (ArchivalCameraStation.shoot_while)
+                moves = (1 if blend else 2) + 2
                 steps.append(Step("scale settles", (x, y, z), wait=settle, wait_during=moves))
                 steps.append(Step("lift", (x, y, travel)))
                 continue  # the camera over it takes it from here
@@ -182,9 +183,10 @@ def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, 
                 serial += overlapping  # what is left of it is waited here
         if moves_left:
             running, moves_left = max(0.0, running - move), moves_left - 1
-            if not moves_left:  # what is left of it is waited here, with this step's own
-                waits += max(running, own_wait)
-                own_wait = 0.0
+            if not moves_left:
+                waits += running  # what is left of it is waited here, before this step's own
+            else:
+                running = max(0.0, running - own_wait)  # this step's own wait passes meanwhile
         if s.wait_during:
             running, moves_left = s.wait, s.wait_during
         waits += own_wait

@@ -544,19 +544,27 @@ class ArchivalCameraStation(StationPlugin):
 
     def shoot_while(self, sherd, weigh) -> str:
         """Over the scale: the photo shot as soon as the sherd is set down and the arm at
-        standby, `weigh()` (the scale's after_place, its outcome returned) run during the
-        image's transfer; then, weighed ('done'), the arm goes back for the sherd and takes it
-        up (`_reach_back`). The capture is kept for after_place, which checks its exposure
-        (a retake sets the sherd down again); one that failed is taken again there. Refused
-        before the shutter: weighed as before, the photo taken after."""
+        standby; during the image's transfer the arm goes back, the fingers round the sherd,
+        `weigh()` (the scale's after_place, its outcome returned) runs, and a sherd weighed
+        ('done') is taken up (`_take_up`). The capture is kept for after_place, which checks
+        its exposure (a retake sets the sherd down again); one that failed is taken again
+        there. Refused before the shutter: weighed as before, the photo taken after."""
         b = self.batch
         outcome, raised = [], []
 
         def during():
             try:
+                # the fingers go round the sherd without touching it while the pan settles (a
+                # touch would show in the readings and be waited out)
+                self._reach_back(sherd, take_up=False)
                 outcome.append(weigh())
                 if outcome[0] == "done":
-                    self._reach_back(sherd)
+                    self._take_up(sherd)
+                else:  # two, or none, on the pan: out of the way, straight up
+                    x, y = sherd.last_xy
+                    b.move_down(x, y, b.travel_z(), sherd.grasp_yaw, linear=True)
+                    self.at_sherd = False
+                    b.poised = None
             except BaseException:
                 raised.append(True)  # the scale's or the arm's failure, not the camera's
                 raise
@@ -583,14 +591,18 @@ class ArchivalCameraStation(StationPlugin):
         self._standby(sherd)
         self._made_way = True
 
-    def _reach_back(self, sherd):
-        """During the transfer: the fingers open around the sherd; and when no later station
-        works on it here, it is picked up too (REPICK's grasp, the lift checked), to wait at
-        travel height above its spot for the photo: carried on only once the photo is in
-        (a retake sets it down again first). The transfer's 1.5 s cover the way back, the
-        close and the lift (timing.md)."""
+    def _reach_back(self, sherd, take_up=True):
+        """During the transfer: the fingers open around the sherd; and (`take_up`) `_take_up`.
+        The transfer's 1.5 s cover the way back, the close and the lift (timing.md)."""
         self.at_sherd = True
         self.reach_back(sherd)
+        if take_up:
+            self._take_up(sherd)
+
+    def _take_up(self, sherd):
+        """The fingers round the sherd: when no later station works on it here, it is picked
+        up (REPICK's grasp, the lift checked), to wait at travel height above its spot for the
+        photo: carried on only once the photo is in (a retake sets it down again first)."""
         b = self.batch
         i = b.plugins.index(self)
         if i + 1 < len(b.plugins) and b.next_stays(i) is None:
