@@ -310,18 +310,23 @@ def test_after_a_restart_a_sherd_lying_on_the_scale(station):
 
 
 # -- the tare done while the arm is away ---------------------------------------------------------
+def _weighed_on_the_early_tare(plugin, sherd, scale, world, recorder):
+    """The next sherd placed on the tare made while away: no tare, no wait above the scale."""
+    t = world.t
+    plugin.before_place(sherd)
+    assert len(scale.tares) == 1 and world.t == t
+    _place(world, scale)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)
+
+
 def test_a_pan_tared_while_the_arm_was_away_is_not_tared_again_nor_waited_for(station):
     plugin, sherd, scale, world, recorder, _ = station
     plugin.while_away()  # the arm at the camera: the pan has read 0 steadily
     plugin.while_away()  # and at the discard box: once is enough
     assert len(scale.tares) == 1
     world.t += 6.0  # the next sherd is picked up and carried over the scale
-    t = world.t
-    plugin.before_place(sherd)
-    assert len(scale.tares) == 1 and world.t == t  # no tare, no wait above the scale
-    _place(world, scale)
-    assert plugin.after_place(sherd) == "done"
-    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)
+    _weighed_on_the_early_tare(plugin, sherd, scale, world, recorder)
     assert not _notes(recorder, "pan_loaded")
     # the next sherd needs a tare of its own
     plugin.before_place(sherd)
@@ -343,12 +348,7 @@ def test_an_early_tare_holds_on_a_pan_flickering_one_digit_either_way(station):
     world.t = tared + 3.0  # the next sherd carried over the scale
     assert settled(scale.readings(tared), 1.0, 1e-4) is None  # the last window 0.2 g apart
     assert plugin.ready_for_place(sherd)
-    t = world.t
-    plugin.before_place(sherd)
-    assert len(scale.tares) == 1 and world.t == t  # no tare, no wait above the scale
-    _place(world, scale)
-    assert plugin.after_place(sherd) == "done"
-    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)
+    _weighed_on_the_early_tare(plugin, sherd, scale, world, recorder)
 
 
 def test_a_pan_still_swinging_is_not_tared_while_the_arm_is_away(station):
