@@ -82,8 +82,8 @@ class Batch:
         self.started = rig.clock.now()
         self.station_names = config.station_order()
         self.plugins = [
-            STATION_PLUGINS[config.stations[n].type](config.stations[n], self)
-            for n in self.station_names
+            STATION_PLUGINS[config.stations[n].type](config.stations[n], self, i)
+            for i, n in enumerate(self.station_names)
         ]
         for before, plugin in zip(self.plugins, self.plugins[1:], strict=False):
             if plugin.station.over_scale:  # the camera shoots the sherd where the scale has it
@@ -131,10 +131,7 @@ class Batch:
         """To each of `steps` ((x, y, z, yaw, linear) as move_down's) in turn, as one motion:
         the next move starts before the one before has stopped wherever the gripper stays above
         arm.blend_z (rig.Arm.move_through); a pending lift (lift_later) goes first."""
-        if self.lift_pending is not None:
-            x, y, yaw = self.lift_pending
-            steps = [(x, y, self.travel_z(), yaw, True)] + list(steps)
-            self.lift_pending = None
+        steps = self.take_lift() + list(steps)
         self.check_stop()
         self.last_pose = None
         self.poised = self.lowered_at = None
@@ -148,6 +145,15 @@ class Batch:
         the next move (move_down, move_through), blended into it: for a lift whose next move
         follows at once, with nothing to check in between."""
         self.lift_pending = (x, y, yaw)
+
+    def take_lift(self) -> list:
+        """The pending lift (lift_later) as move steps, taken: for the caller to make first;
+        none when there is none."""
+        if self.lift_pending is None:
+            return []
+        x, y, yaw = self.lift_pending
+        self.lift_pending = None
+        return [(x, y, self.travel_z(), yaw, True)]
 
     def number_to_next_pick(self, s: "SherdRecord", unused: str):
         """The sherd in progress, not measured, lies among the bag's sherds on the pickup mat

@@ -17,7 +17,7 @@ simulator's models (the scale's settling, the camera's shutter and transfer). Tw
 
 With the camera over the scale (`over_scale`, the one-station layout) the sherd is set down
 once: the scale settles while the arm lifts and goes to standby, the shutter, and the way back
-down round the sherd (ArchivalCameraStation.shoot_while); then the grasp and the lift for the
+down round the sherd (ArchivalCameraStation.measure_here); then the grasp and the lift for the
 discard box, all during the transfer.
 
 Moves the workflow makes as one motion (`Batch.move_through`, with arm.blend_z > 0: the carry
@@ -109,7 +109,7 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
             if after is not None and cfg.stations[after].over_scale:
                 # it settles while the arm goes up and out of the camera's view (make_way:
                 # one motion, or two), the shutter, and the way back down round the sherd
-                # (ArchivalCameraStation.shoot_while)
+                # (ArchivalCameraStation.measure_here)
                 moves = (1 if blend else 2) + 2
                 steps.append(Step("scale settles", (x, y, z), wait=settle, wait_during=moves))
                 steps.append(Step("lift", (x, y, travel)))
@@ -167,35 +167,50 @@ def survey_steps(cfg: Config) -> List[Step]:
     return camera_over_steps(cfg, spots, "survey")
 
 
+class Overlap:
+    """A wait that the next steps are made during: their moves, and the waits between them,
+    pass it (and the last one's own wait with `with_last_wait`); what is left of it is waited
+    after them."""
+
+    def __init__(self, wait: float = 0.0, steps: int = 0, with_last_wait: bool = False):
+        self.left, self.steps, self.with_last_wait = wait, steps, with_last_wait
+
+    def passed(self, move: float, own_wait: float) -> float:
+        """One more step made meanwhile; what is left of the wait once it was the last one
+        (before its own wait without `with_last_wait`), else 0."""
+        if not self.steps:
+            return 0.0
+        self.steps -= 1
+        meanwhile = move + (own_wait if self.steps or self.with_last_wait else 0.0)
+        self.left = max(0.0, self.left - meanwhile)
+        return 0.0 if self.steps else self.rest()
+
+    def rest(self) -> float:
+        """What is left of it, taken (the sequence ended before its steps did)."""
+        left, self.left, self.steps = self.left, 0.0, 0
+        return left
+
+
 def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, list]:
     """(motion, bound waits, serial waits, last joints) of `steps` from the joints `start`."""
     q, motion, waits, serial = start, 0.0, 0.0, 0.0
-    overlapping, over_left = 0.0, 0  # a serial wait the next moves are made during
-    running, moves_left = 0.0, 0  # a wait the next moves are made during (Step.wait_during)
+    serial_over = Overlap()  # a serial wait the next moves are made during (Step.overlaps_next)
+    bound_over = Overlap()  # a wait the next moves are made during (Step.wait_during)
     for s in merged(steps):
         q1 = ik(*s.pose, q)
         move = move_time(q, q1)
         motion += move
         own_wait = 0.0 if s.wait_during else s.wait
-        if over_left:
-            overlapping, over_left = max(0.0, overlapping - move - own_wait), over_left - 1
-            if not over_left:
-                serial += overlapping  # what is left of it is waited here
-        if moves_left:
-            running, moves_left = max(0.0, running - move), moves_left - 1
-            if not moves_left:
-                waits += running  # what is left of it is waited here, before this step's own
-            else:
-                running = max(0.0, running - own_wait)  # this step's own wait passes meanwhile
+        serial += serial_over.passed(move, own_wait)
+        waits += bound_over.passed(move, own_wait) + own_wait
         if s.wait_during:
-            running, moves_left = s.wait, s.wait_during
-        waits += own_wait
+            bound_over = Overlap(s.wait, s.wait_during)
         if s.overlaps_next:
-            overlapping, over_left = s.serial_wait, s.overlaps_next
+            serial_over = Overlap(s.serial_wait, s.overlaps_next, with_last_wait=True)
         else:
             serial += s.serial_wait
         q = q1
-    return motion, waits, serial + (overlapping if over_left else 0.0), q
+    return motion, waits + bound_over.rest(), serial + serial_over.rest(), q
 
 
 def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str, float]:

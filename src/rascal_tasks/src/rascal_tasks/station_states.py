@@ -170,10 +170,8 @@ def repick(b, index) -> bool:
     s = b.sherd
     plugin = b.plugins[index]
     st = plugin.lies_at
-    if plugin.held_up:  # picked up while the station waited (the camera's transfer)
-        plugin.held_up = False
-        if b.rig.gripper.holding():
-            return True
+    if plugin.hand_over() and b.rig.gripper.holding():
+        return True  # picked up while the station waited (the camera's transfer)
     x, y = s.last_xy
     o = placed_observation(b, s, st)
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):

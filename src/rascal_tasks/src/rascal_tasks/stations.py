@@ -7,8 +7,9 @@ No ROS here: plug-ins use the rig interfaces (`rig.py`) and write through the sh
 (`sherd_record.py`).
 """
 
+import enum
 import os
-from typing import Dict, List, Optional, Tuple, Type
+from typing import Callable, Dict, List, NamedTuple, Optional, Tuple, Type
 
 from rascal_tasks.archival import exposure
 from rascal_tasks.archival.exposure import Exposure
@@ -52,15 +53,13 @@ class StationPlugin:
     # so picking it up again is a short descent instead of a trip from travel height.
     hover_after_place = False
 
-    def __init__(self, station, batch):
+    def __init__(self, station, batch, index: int):
         self.station = station  # rascal_tasks.config.Station
         self.batch = batch  # rascal_tasks.batch.Batch
+        self.index = index  # its place in the batch's station order (batch.plugins)
         # the station the sherd lies on while this one works: this one, or the scale for a
         # camera over it (`over_scale`: Batch sets it), where the sherd stays
         self.lies_at = station
-        # the sherd was picked up off `lies_at` while this station waited (the camera's
-        # transfer) and is held at travel height above it: REPICK has nothing to do
-        self.held_up = False
 
     @property
     def stays(self) -> bool:
@@ -89,6 +88,18 @@ class StationPlugin:
         `arm_free`: nothing in the gripper (the station may use the arm). True when it put
         something on the pickup mat (a sherd left on the scale)."""
         return False
+
+    def hand_over(self) -> bool:
+        """Whether the sherd was picked up off `lies_at` while this station waited (the
+        camera's transfer) and is held at travel height above it: REPICK has nothing to do.
+        Asked once, by REPICK: the sherd is the next station's from then on."""
+        return False
+
+    def measure_here(self, sherd, measure: Callable[[], str]) -> str:
+        """For a station that `stays`: the station before measures the sherd lying here,
+        `measure()` (its after_place's work, its outcome returned); this one may work around it
+        meanwhile (the camera over the scale shoots while the pan settles)."""
+        return measure()
 
     def make_way(self, sherd) -> None:
         """For a station that `stays`: the sherd was just set down by the station before, the
@@ -159,8 +170,8 @@ class ScaleStation(StationPlugin):
     status = "weighed"  # or mass_unstable: weighed, but no trustworthy mass
     hover_after_place = True
 
-    def __init__(self, station, batch):
-        super().__init__(station, batch)
+    def __init__(self, station, batch, index):
+        super().__init__(station, batch, index)
         self._tared_for = None  # seq of the sherd the scale was tared (and checked) for
         self._last = None  # the SherdRecord placed on the scale last (it may be done since)
         self._before_tare = 0.0  # kg, what the settled empty pan read before the last tare
@@ -298,7 +309,7 @@ class ScaleStation(StationPlugin):
         early, self._early_tare = self._early_tare, None
         if early is None:
             return False
-        if self._zero_since(early[0], whole_window=True):
+        if self._zero_since(early[0]):
             self._before_tare = early[1]
             return True
         off = self._settled_now(early[0])
@@ -316,14 +327,15 @@ class ScaleStation(StationPlugin):
             )
         return False
 
-    def _zero_since(self, tared_at: float, whole_window: bool) -> bool:
-        """Whether every reading since the tare at `tared_at` is zero within the readability;
-        with `whole_window`, also for a whole window, the last stable (`reads_zero`)."""
+    def _zero_since(self, tared_at: float) -> Optional[bool]:
+        """The readings since the tare at `tared_at`: True when they read zero for a whole
+        window, the last stable (`reads_zero`); False while every one so far reads zero within
+        the readability; None once one does not."""
         readings = self.batch.rig.scale.readings(tared_at)
         readability = self._cfg()["readability"]
-        if whole_window:
-            return reads_zero(readings, self._cfg()["stable_window"], readability)
-        return all(abs(r.mass) <= readability + 1e-9 for r in readings)
+        if any(abs(r.mass) > readability + 1e-9 for r in readings):
+            return None
+        return reads_zero(readings, self._cfg()["stable_window"], readability)
 
     def _tare_once(self) -> Optional[str]:
         """Tare after a settled empty reading, then check it; None when it took, else why not."""
@@ -351,16 +363,18 @@ class ScaleStation(StationPlugin):
         if early is None:
             return False
         if by_arrival:
-            return self._zero_since(early[0], whole_window=False)
+            return self._zero_since(early[0]) is not None
         clock = self.batch.rig.clock
-        while not self._zero_since(early[0], whole_window=True):
-            if not self._zero_since(early[0], whole_window=False):
+        while True:
+            zero = self._zero_since(early[0])
+            if zero:
+                return True
+            if zero is None:
                 return False  # off zero: tared again, the sherd clear of the pan
             if clock.now() >= early[0] + self._cfg()["stable_timeout"]:
                 return False
             self.batch.check_stop()
             clock.sleep(SCALE_POLL)
-        return True
 
     def before_place(self, sherd):
         self._tared_for = None
@@ -394,14 +408,12 @@ class ScaleStation(StationPlugin):
     def after_place(self, sherd):
         b = self.batch
         since = b.rig.clock.now()
-        after = b.next_stays(b.plugins.index(self))
-        shoot = getattr(after, "shoot_while", None)
-        if shoot is None:
+        after = b.next_stays(self.index)  # the camera over the scale shoots while it settles
+
+        def weigh():
             return self._weigh(sherd, since)
-        # the camera over the scale: its shutter needs the arm out of view (it went to standby
-        # as the sherd was set down), not a settled pan: it fires first, the pan settles during
-        # the image's transfer
-        return shoot(sherd, lambda: self._weigh(sherd, since))
+
+        return weigh() if after is None else after.measure_here(sherd, weigh)
 
     def _weigh(self, sherd, since: float) -> str:
         """after_place's weighing, on the readings from `since` (the sherd set down) on."""
@@ -476,6 +488,22 @@ class ScaleStation(StationPlugin):
             sherd.record_mass_unstable(reason)
 
 
+class ArmAt(enum.Enum):
+    """Where the arm is, for the sherd at the archival camera."""
+
+    ABOVE = "above"  # at travel height: placing the sherd lifted it there
+    STANDBY = "standby"  # out of the camera's view (make_way, _standby)
+    ROUND = "round"  # low at the sherd, the fingers open round it (_reach_back)
+    HOLDING = "holding"  # the sherd picked up, held at travel height above its spot (_take_up)
+
+
+class Shot(NamedTuple):
+    """The photo shot while the scale under the camera weighed (measure_here): its capture, or
+    None when the shutter fired and the transfer failed (after_place shoots again)."""
+
+    capture: Optional[object]  # rig.Capture
+
+
 @station_type("archival_camera")
 class ArchivalCameraStation(StationPlugin):
     """The archival photo, shot again a stop darker (twice at most) while its highlights clip
@@ -484,23 +512,29 @@ class ArchivalCameraStation(StationPlugin):
     status = "photographed"
     CAPTURE_ATTEMPTS = 3
 
-    def __init__(self, station, batch):
-        super().__init__(station, batch)
+    def __init__(self, station, batch, index):
+        super().__init__(station, batch, index)
         self.exposure = Exposure()
-        self.at_sherd = False  # the arm reached back for the sherd during a capture
-        self._made_way = False  # the arm went to standby as the sherd was set down (make_way)
-        self._early = None  # (capture or None) of `shoot_while`, for after_place
+        self.arm = ArmAt.ABOVE
+        self._shot: Optional[Shot] = None  # of `measure_here`, for after_place
+
+    def hand_over(self):
+        held = self.arm is ArmAt.HOLDING
+        if held:
+            self.arm = ArmAt.ABOVE
+        return held
 
     def after_place(self, sherd):
         b = self.batch
-        early, self._early = self._early, None
-        if early is None:
-            # placing lifted the arm to travel height, or (on the scale) took it to standby;
-            # after a restart it may be anywhere above the sherd on the scale: straight up first
-            self.at_sherd = self.stays and not self._made_way
-        self._made_way = False
+        shot, self._shot = self._shot, None
+        if shot is None and not self.stays:
+            self.arm = ArmAt.ABOVE  # carried here: placing lifted the arm to travel height
+        elif shot is None and self.arm is not ArmAt.STANDBY:
+            # on the scale, the arm not sent to standby (make_way): after a restart it may be
+            # anywhere above the sherd: straight up first
+            self.arm = ArmAt.ROUND
         with b.phase("data_collection"):
-            capture = early[0] if early is not None else None
+            capture = shot.capture if shot is not None else None
             if capture is None:
                 capture = self._capture(sherd, sherd.spool_path())
             if capture is None:
@@ -542,13 +576,13 @@ class ArchivalCameraStation(StationPlugin):
         self._standby(sherd)
         return None
 
-    def shoot_while(self, sherd, weigh) -> str:
+    def measure_here(self, sherd, measure):
         """Over the scale: the photo shot as soon as the sherd is set down and the arm at
         standby; during the image's transfer the arm goes back, the fingers round the sherd,
-        `weigh()` (the scale's after_place, its outcome returned) runs, and a sherd weighed
-        ('done') is taken up (`_take_up`). The capture is kept for after_place, which checks
-        its exposure (a retake sets the sherd down again); one that failed is taken again
-        there. Refused before the shutter: weighed as before, the photo taken after."""
+        `measure()` (the weighing) runs, and a sherd weighed ('done') is taken up
+        (`_take_up`). The capture is kept for after_place, which checks its exposure (a retake
+        sets the sherd down again); one that failed is taken again there. Refused before the
+        shutter: weighed as before, the photo taken after."""
         b = self.batch
         outcome, raised = [], []
 
@@ -557,13 +591,13 @@ class ArchivalCameraStation(StationPlugin):
                 # the fingers go round the sherd without touching it while the pan settles (a
                 # touch would show in the readings and be waited out)
                 self._reach_back(sherd, take_up=False)
-                outcome.append(weigh())
+                outcome.append(measure())
                 if outcome[0] == "done":
                     self._take_up(sherd)
                 else:  # two, or none, on the pan: out of the way, straight up
                     x, y = sherd.last_xy
                     b.move_down(x, y, b.travel_z(), sherd.grasp_yaw, linear=True)
-                    self.at_sherd = False
+                    self.arm = ArmAt.ABOVE
                     b.poised = None
             except BaseException:
                 raised.append(True)  # the scale's or the arm's failure, not the camera's
@@ -578,23 +612,22 @@ class ArchivalCameraStation(StationPlugin):
                     raise
                 b.event(sherd, "capture_failed", "while weighing: %s" % e.reason)
         if not outcome:  # refused before the shutter: nothing ran
-            return weigh()
+            return measure()
         if outcome[0] == "done":
-            self._early = (capture,)
+            self._shot = Shot(capture)
         elif capture is not None:
             _discard(capture.path)  # not this sherd's photo: two sherds, or none, on the pan
         return outcome[0]
 
     def make_way(self, sherd):
         """Out of view while the scale under the camera settles: the shutter needs no move."""
-        self.at_sherd = False
+        self.arm = ArmAt.ABOVE  # Place's lift goes first (Batch.lift_later)
         self._standby(sherd)
-        self._made_way = True
 
     def _reach_back(self, sherd, take_up=True):
         """During the transfer: the fingers open around the sherd; and (`take_up`) `_take_up`.
         The transfer's 1.5 s cover the way back, the close and the lift (timing.md)."""
-        self.at_sherd = True
+        self.arm = ArmAt.ROUND  # (from wherever the reach stopped, too: up first)
         self.reach_back(sherd)
         if take_up:
             self._take_up(sherd)
@@ -604,13 +637,13 @@ class ArchivalCameraStation(StationPlugin):
         up (REPICK's grasp, the lift checked), to wait at travel height above its spot for the
         photo: carried on only once the photo is in (a retake sets it down again first)."""
         b = self.batch
-        i = b.plugins.index(self)
-        if i + 1 < len(b.plugins) and b.next_stays(i) is None:
+        if self.index + 1 < len(b.plugins) and b.next_stays(self.index) is None:
             # imported here: manipulation -> survey -> batch imports this module
             from rascal_tasks.manipulation import grasp, placed_observation
 
-            self.at_sherd = False  # lifted, held or not: the arm is at travel height
-            self.held_up = grasp(b, placed_observation(b, sherd, self.lies_at), self.lies_at)
+            self.arm = ArmAt.ABOVE  # lifted, held or not: the arm is at travel height
+            if grasp(b, placed_observation(b, sherd, self.lies_at), self.lies_at):
+                self.arm = ArmAt.HOLDING
 
     def _set_down_again(self, sherd):
         """The sherd held up during the transfer goes back onto its spot (a retake, a failed
@@ -620,26 +653,26 @@ class ArchivalCameraStation(StationPlugin):
         from rascal_tasks.station_states import place_z
 
         b = self.batch
-        self.held_up = False
+        self.arm = ArmAt.ABOVE
         if not b.rig.gripper.holding():
             return  # it slipped out above its spot: REPICK looks for it there
         x, y = sherd.last_xy
         b.move_down(x, y, place_z(b, self.lies_at, sherd), sherd.grasp_yaw, linear=True)
         with b.phase("grasping"):
             sherd.width = release(b, sherd.width)
-        self.at_sherd = True
+        self.arm = ArmAt.ROUND
 
     def _standby(self, sherd):
         """Out of the camera's view, the wrist camera facing away too (the sherd was set down
         turned so); from the sherd (a retake, a failed transfer) straight up first, a sherd
         held up during the transfer set down again before."""
         b = self.batch
-        if self.held_up:
+        if self.arm is ArmAt.HOLDING:
             self._set_down_again(sherd)
-        if self.at_sherd:
+        if self.arm is ArmAt.ROUND:
             x, y = sherd.last_xy
             b.lift_later(x, y, sherd.grasp_yaw)  # up and away as one motion
-            self.at_sherd = False
+        self.arm = ArmAt.STANDBY
         sx, sy = b.config["arm"]["standby"]
         b.move_down(sx, sy, b.travel_z(), standby_yaw(b.config, self.station))
 

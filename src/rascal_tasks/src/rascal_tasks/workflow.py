@@ -47,13 +47,11 @@ class Park(BatchState):
 
 
 def park(b: Batch):
-    if b.lift_pending is not None:
-        # the fingers are still low around a sherd they let go of (Batch.lift_later): straight
-        # up first, so the way to the sleep pose does not sweep it away
-        x, y, yaw = b.lift_pending
-        b.lift_pending = None
+    # the fingers may still be low around a sherd they let go of (Batch.lift_later): straight
+    # up first, so the way to the sleep pose does not sweep it away
+    for x, y, z, yaw, linear in b.take_lift():
         try:
-            b.rig.arm.move_down(x, y, b.travel_z(), yaw, linear=True)
+            b.rig.arm.move_down(x, y, z, yaw, linear=linear)
         except RigError as e:
             b.log("parking: the lift before it failed: %s" % e)
     b.rig.arm.go("sleep")
