@@ -420,6 +420,39 @@ def test_a_weighed_sherd_is_never_replaced_by_one_from_the_pickup_area(data):
     assert batch.rig.perception.views == ["scale", "camera"]
 
 
+def _measured_and_dropped(data, world):
+    """The sherd of `_dropped_on_the_way`, weighed and photographed, lifted off the camera's
+    spot and dropped on its way to the discard box."""
+    batch = _dropped_on_the_way(data, world)
+    s = batch.sherd
+    s.placed(batch.config.stations["camera"], s.grasp_yaw)
+    s.station_index = 1
+    return batch
+
+
+def test_a_measured_sherd_dropped_on_the_way_to_the_box_and_not_seen_is_recorded_done(data):
+    # a look-alike lies in the box: it is not taken out (one there is where this one was going)
+    box = config_from_dict(data).stations["discard"]
+    batch = _measured_and_dropped(data, {"discard": [_obs(*box.place_at, 0.055, 0.040)]})
+    assert Recover(batch).run() == "done"
+    assert batch.rig.perception.views == ["camera"]  # where it was lifted, the next sherd's spot
+    assert ("done", 4) == batch.recorder.calls[-1][:2]
+    assert batch.completed == 1 and batch.lost == 0 and batch.sherd is None
+    notes = [c[2] for c in batch.recorder.calls if c[0] == "note"]
+    assert any("dropped on its way to the discard" in n for n in notes), notes
+
+
+def test_a_measured_sherd_dropped_back_onto_its_station_is_picked_up_again(data):
+    camera = config_from_dict(data).stations["camera"]
+    batch = _measured_and_dropped(data, {"camera": [_obs(*camera.place_at, 0.055, 0.040)]})
+    assert Recover(batch).run() == "held"
+    assert batch.completed == 0 and not any(c[0] == "done" for c in batch.recorder.calls)
+    # one not measured yet (weighed only) and not found is still lost, as before
+    batch = _dropped_on_the_way(data, {})
+    batch.sherd.station_index = 0
+    assert Recover(batch).run() == "lost"
+
+
 def test_a_sherd_seen_off_the_station_is_left_for_a_person(data):
     # it fell off the scale onto the table: another height than the pan, no grasp planned there
     batch = _dropped_on_the_way(data, {"scale": [_obs(0.32, -0.12, 0.055, 0.040)]})

@@ -24,12 +24,15 @@ class Recover(BatchState):
     mass or photo in its row). Of what is found, the one most like it (position, then size) is
     taken, so another sherd lying near is not; what lies off a station is left for a person.
     One found on the pickup mat before it was measured that the grasps fail on is not lost: it
-    lies among the bag's sherds, and its number goes to the next sherd picked ('returned')."""
+    lies among the bag's sherds, and its number goes to the next sherd picked ('returned').
+    One measured at every station, dropped on its way to the discard box, is looked for only
+    where it was lifted (where the next sherd goes): not seen there, it is recorded done, said
+    on its row ('done'): its row is whole, and a sherd in the box is where it was going."""
 
     next_sherd = "lost"
 
     def __init__(self, batch):
-        super().__init__(batch, ["held", "lost", "returned"])
+        super().__init__(batch, ["held", "lost", "returned", "done"])
 
     def run(self):
         b = self.batch
@@ -38,6 +41,8 @@ class Recover(BatchState):
             return self.lose("dropped %d times" % s.drops)
         station, candidates, ref = self.search(s)
         like = s.observation
+        if not candidates and self.measured(s):
+            return self.done_unseen(s)
         if not candidates:
             return self.lose(
                 "not found where it was last seen (%s)%s"
@@ -72,6 +77,24 @@ class Recover(BatchState):
             s.record_dimensions(o)
         return "held"
 
+    def measured(self, s: SherdRecord) -> bool:
+        """Whether every station after the last one done with `s` only lets it fall (the
+        discard box): nothing is left to measure."""
+        later = self.batch.plugins[s.station_index + 1 :]
+        return s.station_index >= 0 and all(p.release_from_above for p in later)
+
+    def done_unseen(self, s: SherdRecord) -> str:
+        box = self.batch.plugins[s.station_index + 1].target(s)
+        self.batch.event(
+            s,
+            "not_seen_discarded",
+            "dropped on its way to the %s and not on the %s it was lifted from: it lies in the "
+            "box or on the table near the way; every measurement was taken before"
+            % (box.name, s.where),
+        )
+        s.done()
+        return "done"
+
     def lose(self, reason: str) -> str:
         self.batch.sherd.lose(reason)
         return "lost"
@@ -85,7 +108,9 @@ class Recover(BatchState):
             # Lifted from a station after it was measured: it was never above the pickup area
             # again. It fell where it was lifted, or where it was carried to.
             nxt = s.station_index + 1
-            if nxt < len(b.plugins) and b.plugins[nxt].lies_at is not where:
+            if self.measured(s):
+                pass  # one in the box is where it was going; none is picked out of it
+            elif nxt < len(b.plugins) and b.plugins[nxt].lies_at is not where:
                 places.append((b.plugins[nxt].lies_at, b.plugins[nxt].lies_at.place_at))
         elif s.picked_xy is not None and (where is not b.pickup or s.picked_xy != s.last_xy):
             places.append((b.pickup, s.picked_xy))

@@ -268,12 +268,17 @@ class ScaleStation(StationPlugin):
         as its own sherd (station_states.clear_to_mat). True when the pan was cleared."""
         b = self.batch
         s = self._last  # the sherd in progress, or done since (the camera over the scale)
-        if s is not None and s.status == "lost":
-            # most likely that sherd itself (the grasps on it failed here): taken to the mat,
-            # it would be picked and recorded a second time, as a new row
+        itself = s is not None and (
+            s.status == "lost"  # the grasps on it failed here
+            or (s.mass is not None and abs(kg - s.mass) <= 2 * self._cfg()["readability"])
+        )
+        if itself:
+            # most likely that sherd itself (recorded lost here, or dropped back unseen): taken
+            # to the mat, it would be picked and recorded a second time, as a new row
             b.log(
-                "%.1f g lies on the scale after sherd %s was recorded lost there: left for a "
-                "person" % (kg * 1000, s.seq)
+                "%.1f g lies on the scale after sherd %s (%s, %s) left it: most likely that "
+                "sherd; left for a person"
+                % (kg * 1000, s.seq, s.status, "%.1f g" % (s.mass * 1000) if s.mass else "no mass")
             )
             return False
         if s is not None and s.mass is not None and self._tared_for == s.seq:

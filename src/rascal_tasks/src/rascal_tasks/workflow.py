@@ -111,6 +111,7 @@ def build_machine(batch: Batch):
                 held="TRANSLATE_%d" % i,
                 lost="SURVEY_NEXT",
                 returned="SURVEY",
+                done="SURVEY_NEXT",
             )
         add("SURVEY_NEXT", NextSherd(batch), pickup="PICKUP", survey="SURVEY")
         add("PARK", Park(batch), done="finished", aborted="aborted", preempted="preempted")
