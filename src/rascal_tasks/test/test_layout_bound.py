@@ -118,6 +118,23 @@ def test_a_transfer_is_made_during_the_next_moves_and_their_waits():
     assert serial(three / 2) == pytest.approx(0.0)
 
 
+def test_the_batch_start_and_end_are_shared_by_its_sherds(data):
+    """The measured seconds per sherd count the batch's own moves (from the sleep pose, the
+    stations' backgrounds, the first survey, the surveys that find the mat empty, the park):
+    the bound counts them too, shared by the batch's sherds; `cycle` leaves them out."""
+    cfg = config_from_dict(data)
+    ten, twenty = lb.bound_of(cfg, ik, 10), lb.bound_of(cfg, ik, 20)
+    assert ten["batch"] == pytest.approx(2 * twenty["batch"])
+    # more than the one survey the cycle alone shares: the start and the closing surveys
+    assert ten["batch"] > 2 * ten["survey"] > 0
+    assert ten["bound"] - ten["cycle"] == pytest.approx(ten["batch"] - ten["survey"])
+    # one more closing survey costs its moves over the mat (not the way there and back)
+    more = copy.deepcopy(data)
+    more["recovery"]["max_empty_surveys"] += 1
+    extra = lb.bound_of(config_from_dict(more), ik, 10)["batch"] - ten["batch"]
+    assert 0 < extra < ten["survey"]
+
+
 def test_one_station_bound_is_below_the_separate_stations(data):
     with open(os.path.join(WORKSPACE, "config", "layouts", "one_station.yaml")) as f:
         one = config_from_dict(merged(data, yaml.safe_load(f)))

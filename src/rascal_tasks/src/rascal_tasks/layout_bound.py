@@ -25,8 +25,13 @@ and the descent at a station, the lift from the scale and the way to standby)
 are timed as one move from where the first starts to where the last ends: no motion through
 those points can be faster, whatever corner it cuts.
 
-Pickup spots are averaged over a grid of the pickup area; the lawnmower survey is shared by the
-batch's sherds. No ROS here: `rosrun rascal_tasks layout_bound` (scripts/) gives `bound_of` the
+Pickup spots are averaged over a grid of the pickup area. The batch's own moves are shared by its
+sherds, as the measured seconds per sherd share them: from the sleep pose over the pickup area,
+the wrist camera over each station to learn its background, the first lawnmower survey, the
+surveys that find the mat empty (recovery.max_empty_surveys) and the park (`batch`); `cycle` is
+the figure without them (one survey shared, as before they were counted).
+
+No ROS here: `rosrun rascal_tasks layout_bound` (scripts/) gives `bound_of` the
 arm controller's IK.
 """
 
@@ -167,6 +172,22 @@ def survey_steps(cfg: Config) -> List[Step]:
     return camera_over_steps(cfg, spots, "survey")
 
 
+def start_steps(cfg: Config) -> List[Step]:
+    """A batch's moves before its first sherd, from the sleep pose: over the pickup area
+    (resume.Home), the wrist camera over each station a sherd is set down at to learn its
+    background (resume.Calibrate), the first survey."""
+    pickup, travel = cfg.stations["pickup"], cfg["arm"]["travel_z"]
+    steps = [Step("home", (*pickup.area.center, travel))]
+    for name in cfg.station_order():
+        st = cfg.stations[name]
+        if st.over_scale:
+            continue  # the camera over the scale: learnt with the scale
+        ex, ey, _ = gripper_for_camera_over(*st.place_at)
+        z = st.surface_z + cfg["survey"]["z"]
+        steps.append(Step("learn " + name, (ex, ey, z), wait=cfg["survey"]["settle_time"]))
+    return steps + survey_steps(cfg)
+
+
 class Overlap:
     """A wait that the next steps are made during: their moves, and the waits between them,
     pass it (and the last one's own wait with `with_last_wait`); what is left of it is waited
@@ -213,9 +234,14 @@ def timed(steps: List[Step], ik: Callable, start) -> Tuple[float, float, float, 
     return motion, waits + bound_over.rest(), serial + serial_over.rest(), q
 
 
-def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str, float]:
-    """Seconds per sherd at the limits, averaged over the pickup grid. `ik(x, y, z, seed)` ->
-    joints of ee_gripper_link pointing down at (x, y, z), yaw along the arm."""
+def bound_of(cfg: Config, ik: Callable, sherds: int = 10) -> Dict[str, float]:
+    """Seconds per sherd at the limits, averaged over the pickup grid, for a batch of `sherds`
+    (one survey finds them all). `ik(x, y, z, seed)` -> joints of ee_gripper_link pointing
+    down at (x, y, z), yaw along the arm. `bound`: the sherd's own moves and waits plus its
+    share of the batch's (`batch`: from the sleep pose through the stations' background and
+    the first survey, the surveys that find the mat empty, recovery.max_empty_surveys, and the
+    park), as the measured seconds per sherd count them; `cycle`: the sherd's own plus its
+    share of one survey alone (the batch's start and end left out)."""
     st = cfg.stations["pickup"]
     (cx, cy), (sx, sy) = st.area.center, st.area.size
     nx, ny = PICKUP_GRID
@@ -225,19 +251,28 @@ def bound_of(cfg: Config, ik: Callable, sherds_per_survey: int = 10) -> Dict[str
         for j in range(ny)
     ]
     dx, dy = cfg.stations["discard"].place_at
-    home = ik(dx, dy, cfg["arm"]["travel_z"], None)
+    discard = ik(dx, dy, cfg["arm"]["travel_z"], None)  # where every sherd's sequence starts
     totals = {"motion": 0.0, "waits": 0.0, "serial_waits": 0.0}
     # a survey's first sherd is grasped from the survey's detection, the others after a look
-    looked = (sherds_per_survey - 1) / max(1, sherds_per_survey)
+    looked = (sherds - 1) / max(1, sherds)
     for spot in spots:
         for look, share in ((True, looked), (False, 1.0 - looked)):
-            m, w, s, _ = timed(sequence(cfg, spot, look), ik, home)
+            m, w, s, _ = timed(sequence(cfg, spot, look), ik, discard)
             totals["motion"] += share * m / len(spots)
             totals["waits"] += share * w / len(spots)
             totals["serial_waits"] += share * s / len(spots)
-    m, w, _, q = timed(survey_steps(cfg), ik, home)
-    m += move_time(q, home)
-    totals["survey"] = (m + w) / max(1, sherds_per_survey)
-    totals["bound"] = totals["motion"] + totals["waits"] + totals["survey"]
+    m, w, _, q = timed(survey_steps(cfg), ik, discard)
+    totals["survey"] = (m + w + move_time(q, discard)) / max(1, sherds)
+    # the first sherd counted from the discard box as every other, not from the survey's end
+    sleep = cfg["arm"]["named_poses"]["sleep"]
+    m, w, _, _ = timed(start_steps(cfg), ik, sleep)
+    q = discard
+    for _ in range(cfg["recovery"]["max_empty_surveys"]):
+        mi, wi, _, q = timed(survey_steps(cfg), ik, q)
+        m, w = m + mi, w + wi
+    totals["batch"] = (m + w + move_time(q, sleep)) / max(1, sherds)
+    own = totals["motion"] + totals["waits"]
+    totals["cycle"] = own + totals["survey"]
+    totals["bound"] = own + totals["batch"]
     totals["serial"] = totals["bound"] + totals["serial_waits"]
     return totals
