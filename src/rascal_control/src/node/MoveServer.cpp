@@ -70,6 +70,10 @@ PlanResult MoveServer::plan(const rascal_msgs::MoveArmGoal& goal, const JointVec
   const bool linear = goal.motion == rascal_msgs::MoveArmGoal::MOTION_LINEAR;
   JointVector target_joints{};
   std::lock_guard<std::mutex> lock(core_mutex_);
+  if (!goal.then_poses.empty() && goal.target_type != rascal_msgs::MoveArmGoal::TARGET_POSE) {
+    failed.message = "then_poses need a pose target (target_type TARGET_POSE)";
+    return failed;
+  }
   switch (goal.target_type) {
     case rascal_msgs::MoveArmGoal::TARGET_POSE: {
       const std::string& frame = goal.pose.header.frame_id;
@@ -90,10 +94,6 @@ PlanResult MoveServer::plan(const rascal_msgs::MoveArmGoal& goal, const JointVec
                     : planner_.planJointToPose(start, target_pose, scale);
     }
     case rascal_msgs::MoveArmGoal::TARGET_NAMED: {
-      if (!goal.then_poses.empty()) {
-        failed.message = "then_poses need a pose target (target_type TARGET_POSE)";
-        return failed;
-      }
       const auto it = params_.named_poses.find(goal.named_pose);
       if (it == params_.named_poses.end()) {
         std::string known;
@@ -105,10 +105,6 @@ PlanResult MoveServer::plan(const rascal_msgs::MoveArmGoal& goal, const JointVec
       break;
     }
     case rascal_msgs::MoveArmGoal::TARGET_JOINTS:
-      if (!goal.then_poses.empty()) {
-        failed.message = "then_poses need a pose target (target_type TARGET_POSE)";
-        return failed;
-      }
       if (goal.joints.size() != kArmJoints) {
         failed.message = "joint goal has " + std::to_string(goal.joints.size()) + " values, expected 6";
         return failed;
