@@ -12,7 +12,7 @@ weighs what lies on it. `Recorder` keeps the catalogue's status rules in memory.
 import math
 import os
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 
 from rascal_tasks import rig, workflow
@@ -87,6 +87,8 @@ class World:
         # sherd name -> the sherd lying under it that its first grasp lifts too (a heap); set
         # down together, the second lands `DOUBLE_APART` from the first
         self.doubles: Dict[str, str] = {}
+        # grasped sherd -> (a neighbour, where its grasp shoves it): a nudge, or off the mat
+        self.knock_off: Dict[str, Tuple[str, Tuple[float, float]]] = {}
         # set down together on the mat, the two stay one on the other (else they fall apart)
         self.stay_stacked = False
         self.held_extra: Optional[Sherd] = None
@@ -199,6 +201,12 @@ class _Gripper(rig.Gripper):
                     self.w.bad_holds[s.name] -= 1
                     break
                 self.w.held, self.w.grasped_at = s, (x, y)
+                knocked = self.w.knock_off.pop(s.name, None)
+                if knocked is not None:  # the fingers came down on a neighbour and shoved it
+                    name, xy = knocked
+                    n = next(p for p in self.w.sherds if p.name == name)
+                    if n.station == "pickup":
+                        self.w.put(n, *xy)
                 partner = self.w.doubles.pop(s.name, None)
                 if partner is not None:
                     self.w.held_extra = next(p for p in self.w.sherds if p.name == partner)

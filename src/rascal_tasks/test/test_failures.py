@@ -247,6 +247,33 @@ def test_a_sherd_that_slips_away_from_a_heap_is_said_though_others_lie_near(conf
     assert batch.slipped_away == [(0.25, 0.30)]
 
 
+def test_a_sherd_pushed_off_the_mat_by_a_grasp_beside_it_is_said(config):
+    # near the far edge (y 0.33): without a look for it, the batch would end "complete" one
+    # sherd short, and nobody would know
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.12, 0.31)])
+    world.knock_off["a"] = ("b", (0.12, 0.37))
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    assert batch.vanished == [pytest.approx((0.12, 0.31))]
+    assert "1 sherd seen near the mat's edge, not picked up and not seen again" in what_is_left(
+        batch, []
+    )
+
+
+def test_a_sherd_nudged_by_a_grasp_beside_it_or_picked_is_not_said(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.12, 0.31)])
+    world.knock_off["a"] = ("b", (0.13, 0.29))  # nudged 22 mm, still on the mat
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
+    assert batch.vanished == [] and what_is_left(batch, []) == ""
+    # one in the middle of the mat moved far (under another, or shoved along) is not said: the
+    # mat still holds it
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.16, 0.25)])
+    world.knock_off["a"] = ("b", (0.40, 0.0))  # gone from the mat, but not from near its edge
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished" and batch.vanished == []
+
+
 def test_an_arm_timeout_parks_and_stops_with_nothing_else_recorded(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
     scale = config.stations["scale"]

@@ -72,6 +72,11 @@ class Batch:
         self.renumber: Optional[SherdRecord] = None
         self.renumber_unused = ""  # why that row is recorded lost if the mat empties first
         self.seen: List[Observation] = []  # the last survey of the pickup area, merged
+        # (x, y) where sherds were taken off the pickup mat since that survey
+        self.taken_since_survey: List[tuple] = []
+        # where a sherd of the last survey lay near the mat's edge, not taken and not seen
+        # again by the next: a grasp beside it may have pushed it off the mat
+        self.vanished: List[tuple] = []
         # what the last survey saw on the mat but perception did not offer (rig.Leftover)
         self.leftovers: List = []
         self.empty_surveys = 0

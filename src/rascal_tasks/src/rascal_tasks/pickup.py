@@ -45,6 +45,7 @@ class Pickup(BatchState):
         # again (survey.account_for_slips), unless the retry took it at once
         b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
         if held:
+            b.taken_since_survey.append((o.x, o.y))
             if b.renumber is not None:  # two were put back: this one takes over that number
                 b.sherd, b.renumber = b.renumber, None
                 b.sherd.taken_over(o, b.pickup)

@@ -71,6 +71,8 @@ class Recover(BatchState):
             s, "recovered", "picked up again at the %s, (%.3f, %.3f) m" % (station.name, o.x, o.y)
         )
         s.grasped_as(o, station)
+        if station is b.pickup:
+            b.taken_since_survey.append((o.x, o.y))
         if station is b.pickup and s.station_index < 0:
             # Picked afresh from the pickup area: what is in the gripper now is what gets measured.
             s.seen(o, b.pickup)

@@ -280,6 +280,7 @@ class Run:
             if done:  # what the batch before learnt about the mat
                 batch.unpickable = done[-1].unpickable
                 batch.slipped_away = done[-1].slipped_away
+                batch.vanished = done[-1].vanished
                 batch.misses = done[-1].misses
                 batch.pushed = done[-1].pushed
                 batch.pushed_to = done[-1].pushed_to
@@ -326,6 +327,7 @@ class Run:
                     # what the person is told to look at stays with the context's history
                     "not_taken": [describe_leftover(lo) for lo in done[-1].leftovers],
                     "slipped_away": [list(xy) for xy in done[-1].slipped_away],
+                    "not_seen_again": [list(xy) for xy in done[-1].vanished],
                 },
             )
         except psycopg2.Error as e:  # not logged: the next run resumes, which loses nothing
@@ -484,6 +486,11 @@ def what_is_left(batch, rows) -> str:
             "slipped out of the fingers while lifted and not seen again (it may lie beside the "
             "mat: if every sherd of the bag is recorded, it was found again)",
         ),
+        (
+            len(batch.vanished),
+            "seen near the mat's edge, not picked up and not seen again (a grasp beside it may "
+            "have pushed it off the mat)",
+        ),
         (sum(r["status"] == "lost" for r in rows), "recorded lost"),
         (
             sum(r["status"] not in ("lost", "picked") and r.get("mass_g") is None for r in rows),
@@ -527,6 +534,11 @@ def print_summary(batches, rows, outcome, wall_seconds):
         print(describe_leftover(lo))
     for x, y in batches[-1].slipped_away:
         print("slipped out of the fingers while lifted at (%.3f, %.3f) m, not seen again" % (x, y))
+    for x, y in batches[-1].vanished:
+        print(
+            "seen near the mat's edge at (%.3f, %.3f) m, not picked up, not seen again: look "
+            "beside the mat" % (x, y)
+        )
     state_times = {}
     for b in batches:
         for k, v in b.state_times.items():

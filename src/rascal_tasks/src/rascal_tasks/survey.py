@@ -103,6 +103,40 @@ def account_for_slips(b, found: List[Observation]):
     b.unchecked_slips = []
 
 
+def near_the_edge(area, o: Observation) -> bool:
+    """Whether `o` lies within its own length of the pickup area's edge (config.Rect): a shove
+    of its own size could put it off the mat."""
+    (cx, cy), (sx, sy) = area.center, area.size
+    return min(sx / 2 - abs(o.x - cx), sy / 2 - abs(o.y - cy)) <= o.length
+
+
+def account_for_vanished(b, found: List[Observation]):
+    """Each sherd of the survey before (`b.seen`) lying near the mat's edge that was not taken
+    off the mat since must be seen again: something within recovery.search_radius of where it
+    lay (a neighbour's grasp may nudge it; in a heap it may change its outline). One not seen
+    may have been pushed off the mat by a grasp beside it: said, and the batch ends
+    incomplete (a sherd recorded nowhere and said nowhere is the one failure a person would
+    never notice)."""
+    radius = b.config["recovery"]["search_radius"]
+    seen = list(found) + list(b.leftovers)
+    for o in b.seen:
+        if not near_the_edge(b.pickup.area, o):
+            continue  # moved, or under another: the mat still holds it
+        if any(math.hypot(o.x - x, o.y - y) < radius for x, y in b.taken_since_survey):
+            continue
+        if any(c.distance_to(o.x, o.y) < radius for c in seen):
+            continue
+        b.vanished.append((o.x, o.y))
+        b.event(
+            None,
+            "not_seen_again",
+            "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge was not picked "
+            "up and is not seen within %.0f mm of there since: a grasp beside it may have "
+            "pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
+        )
+    b.taken_since_survey = []
+
+
 def merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
     """Add to `found` the detections of `new` that are not a sherd already in it."""
     for o in new:
@@ -134,7 +168,9 @@ def survey_pickup_area(b) -> List[Observation]:
         lo for lo in b.leftovers if all(o.distance_to(lo.x, lo.y) > SAME_SHERD for o in found)
     ]
     account_for_slips(b, found)
-    return [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)]
+    account_for_vanished(b, found)
+    b.seen = [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)]
+    return list(b.seen)
 
 
 class Survey(BatchState):
@@ -146,7 +182,6 @@ class Survey(BatchState):
     def run(self):
         b = self.batch
         found = survey_pickup_area(b)
-        b.seen = list(found)
         if not found:
             if lay_flat(b):  # a sherd standing on its edge, pushed over: it may be picked now
                 return self.run()
