@@ -255,6 +255,12 @@ def test_a_sherd_pushed_off_the_mat_by_a_grasp_beside_it_is_said(config):
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished" and rec.status() == {1: "done"}
     assert batch.vanished == [pytest.approx((0.12, 0.31))]
+    # shoved off by the grasp of a sherd lying right beside it (within the search radius):
+    # that neighbour taken does not count for it
+    world = World(config, [Sherd("a", 0.12, 0.27), Sherd("b", 0.12, 0.31)])
+    world.knock_off["a"] = ("b", (0.12, 0.37))
+    outcome, batch, rec = _run(config, world)
+    assert rec.status() == {1: "done"} and batch.vanished == [pytest.approx((0.12, 0.31))]
     assert "1 sherd seen near the mat's edge, not picked up and not seen again" in what_is_left(
         batch, []
     )

@@ -30,7 +30,7 @@ class Pickup(BatchState):
         # the first station may get ready for this sherd meanwhile (the scale's tare, then
         # checked by the time the sherd is carried there: lowered onto it without a stop)
         b.plugins[0].while_away(arm_free=False)
-        o = b.pending.pop(0)
+        o = surveyed = b.pending.pop(0)
         if b.pending_stale:
             # the mat changed since the survey (a grasp here): the sherd is grasped where the
             # wrist camera sees it now, never where it lay before
@@ -45,7 +45,8 @@ class Pickup(BatchState):
         # again (survey.account_for_slips), unless the retry took it at once
         b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
         if held:
-            b.taken_since_survey.append((o.x, o.y))
+            # the survey's sherd itself (a neighbour its grasp shoves lies within the radius)
+            b.taken_since_survey.append((surveyed.x, surveyed.y))
             if b.renumber is not None:  # two were put back: this one takes over that number
                 b.sherd, b.renumber = b.renumber, None
                 b.sherd.taken_over(o, b.pickup)

@@ -112,8 +112,9 @@ def near_the_edge(area, o: Observation) -> bool:
 
 def account_for_vanished(b, found: List[Observation]):
     """Each sherd of the survey before (`b.seen`) lying near the mat's edge that was not taken
-    off the mat since must be seen again: something within recovery.search_radius of where it
-    lay (a neighbour's grasp may nudge it; in a heap it may change its outline). One not seen
+    off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
+    seen again: something within recovery.search_radius of where it lay (a neighbour's grasp
+    may nudge it; in a heap it may change its outline, and others lie near). One not seen
     may have been pushed off the mat by a grasp beside it: said, and the batch ends
     incomplete (a sherd recorded nowhere and said nowhere is the one failure a person would
     never notice)."""
@@ -122,8 +123,8 @@ def account_for_vanished(b, found: List[Observation]):
     for o in b.seen:
         if not near_the_edge(b.pickup.area, o):
             continue  # moved, or under another: the mat still holds it
-        if any(math.hypot(o.x - x, o.y - y) < radius for x, y in b.taken_since_survey):
-            continue
+        if any(math.hypot(o.x - x, o.y - y) <= SAME_SHERD for x, y in b.taken_since_survey):
+            continue  # taken itself (a neighbour taken beside it does not count)
         if any(c.distance_to(o.x, o.y) < radius for c in seen):
             continue
         b.vanished.append((o.x, o.y))
