@@ -9,7 +9,7 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.rig import Observation
-from rascal_tasks.selection import covered, in_pick_order, same_size
+from rascal_tasks.selection import SAME_SIZE, covered, in_pick_order, same_size
 from rascal_tasks.singulation import lay_flat
 
 # Wrist camera offset from ee_gripper_link when the gripper points down, along the gripper's
@@ -113,19 +113,22 @@ def near_the_edge(area, o: Observation) -> bool:
 def account_for_vanished(b, found: List[Observation]):
     """Each sherd of the survey before (`b.seen`) lying near the mat's edge that was not taken
     off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
-    seen again: something within recovery.search_radius of where it lay (a neighbour's grasp
-    may nudge it; in a heap it may change its outline, and others lie near). One not seen
+    seen again: a sherd at least about as long within recovery.search_radius of where it lay
+    (a neighbour's grasp may nudge it; in a heap a sherd uncovered since shows more of itself,
+    and smaller ones always lie near), or anything perception does not offer. One not seen
     may have been pushed off the mat by a grasp beside it: said, and the batch ends
     incomplete (a sherd recorded nowhere and said nowhere is the one failure a person would
     never notice)."""
     radius = b.config["recovery"]["search_radius"]
-    seen = list(found) + list(b.leftovers)
     for o in b.seen:
         if not near_the_edge(b.pickup.area, o):
             continue  # moved, or under another: the mat still holds it
         if any(math.hypot(o.x - x, o.y - y) <= SAME_SHERD for x, y in b.taken_since_survey):
             continue  # taken itself (a neighbour taken beside it does not count)
-        if any(c.distance_to(o.x, o.y) < radius for c in seen):
+        as_long = (1.0 - SAME_SIZE) * o.length
+        if any(c.distance_to(o.x, o.y) < radius and c.length >= as_long for c in found):
+            continue
+        if any(lo.distance_to(o.x, o.y) < radius for lo in b.leftovers):
             continue
         b.vanished.append((o.x, o.y))
         b.event(
