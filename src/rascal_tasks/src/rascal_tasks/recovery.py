@@ -86,6 +86,7 @@ class Recover(BatchState):
         return s.station_index >= 0 and all(p.release_from_above for p in later)
 
     def done_unseen(self, s: SherdRecord) -> str:
+        """`s`, measured, not where it was lifted: recorded done, where it may lie said."""
         box = self.batch.plugins[s.station_index + 1].target(s)
         self.batch.event(
             s,
