@@ -98,6 +98,24 @@ bool fullyInView(const Truth& t, const rascal_perception::CameraView& view) {
   return true;
 }
 
+int falseParts(const Frame& f, const std::vector<rascal_perception::Leftover>& leftovers, int* parts) {
+  int false_parts = 0;
+  for (const rascal_perception::Leftover& l : leftovers) {
+    if (!l.cut_by_border) continue;
+    const bool part = std::any_of(f.truth.begin(), f.truth.end(), [&](const Truth& t) {
+      return !fullyInView(t, f.view) && (l.position.head<2>() - t.centre).norm() <= 0.5 * std::hypot(t.length, t.width);
+    });
+    if (part && parts) ++*parts;
+    if (!part) ++false_parts;
+  }
+  return false_parts;
+}
+
+int wholeLeftovers(const std::vector<rascal_perception::Leftover>& leftovers) {
+  return static_cast<int>(std::count_if(leftovers.begin(), leftovers.end(),
+                                        [](const rascal_perception::Leftover& l) { return !l.cut_by_border; }));
+}
+
 Frame render(const Scenario& scenario, const JointVector& q) {
   // one simulator per arm pose, reloaded with each scenario (building one costs more than a frame)
   static std::map<JointVector, std::unique_ptr<Simulator>> cache;

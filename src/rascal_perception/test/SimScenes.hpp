@@ -36,6 +36,11 @@ struct Frame {
 
 /// Is the truth sherd entirely in the image, 5 px from its edges (so it must be found)?
 bool fullyInView(const Truth& t, const rascal_perception::CameraView& view);
+/// Leftovers said to be cut by the image border that are no part of a sherd partly in view
+/// (their centre inside no such sherd's outline circle); the others are counted in `parts`.
+int falseParts(const Frame& f, const std::vector<rascal_perception::Leftover>& leftovers, int* parts = nullptr);
+/// How many leftovers were seen whole (not cut by the image border).
+int wholeLeftovers(const std::vector<rascal_perception::Leftover>& leftovers);
 /// The detector as the node configures it: the shipped config/rascal.yaml and the package URDF's
 /// gripper (read once).
 const rascal_perception::DetectorParameters& shippedDetector();

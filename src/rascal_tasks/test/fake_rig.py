@@ -94,6 +94,10 @@ class World:
         self.held_extra: Optional[Sherd] = None
         self.opening: Optional[float] = None  # where the last open sent the fingers (None: closed)
         self.bad_holds: Dict[str, int] = {}  # sherd name -> grasps on it that close on nothing
+        # the wrist camera sees this far around its axis; with `view_cuts`, a sherd reaching
+        # beyond it is cut by the image border as by the detector: not offered, said as a part
+        self.view_radius = VIEW_RADIUS
+        self.view_cuts = False
 
     def station_at(self, x, y):
         for st in self.config.stations.values():
@@ -246,10 +250,40 @@ class _Perception(rig.Perception):
     def calibrate(self, station):
         self.calibrated.append(station)
 
-    def _in_view(self, station):
+    def _camera(self):
         x, y, _, yaw = self.w.at
-        cx, cy = x + CAMERA_OFFSET * math.cos(yaw), y + CAMERA_OFFSET * math.sin(yaw)
-        return [s for s in self.w.lying(station) if math.hypot(s.x - cx, s.y - cy) < VIEW_RADIUS]
+        return x + CAMERA_OFFSET * math.cos(yaw), y + CAMERA_OFFSET * math.sin(yaw)
+
+    def _cut(self, s) -> bool:
+        """Whether the view's edge cuts `s` (only with World.view_cuts)."""
+        cx, cy = self._camera()
+        return (
+            self.w.view_cuts and math.hypot(s.x - cx, s.y - cy) + s.length / 2 > self.w.view_radius
+        )
+
+    def _in_view(self, station, cut=False):
+        """The sherds whose centre is in view; those the view's edge cuts only with `cut`."""
+        cx, cy = self._camera()
+        return [
+            s
+            for s in self.w.lying(station)
+            if math.hypot(s.x - cx, s.y - cy) < self.w.view_radius and (cut or not self._cut(s))
+        ]
+
+    def _part(self, s, surface) -> rig.Leftover:
+        """The part of `s` in view: half of it, on the camera's side."""
+        cx, cy = self._camera()
+        d = math.hypot(s.x - cx, s.y - cy) or 1.0
+        k = s.length / 4 / d
+        return rig.Leftover(
+            s.x + k * (cx - s.x),
+            s.y + k * (cy - s.y),
+            s.length / 2,
+            s.width,
+            "cut by the image border",
+            surface,
+            cut_by_border=True,
+        )
 
     def _pickable(self, s):
         return not s.standing and s.width >= self.w.config["perception"]["min_sherd_size"]
@@ -272,7 +306,7 @@ class _Perception(rig.Perception):
             )
             for s in self._in_view(station)
             if not self._pickable(s)
-        ]
+        ] + [self._part(s, surface) for s in self._in_view(station, cut=True) if self._cut(s)]
 
     def detect(self, station):
         surface = self.w.config.stations[station].surface_z

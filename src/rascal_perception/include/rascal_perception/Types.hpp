@@ -92,7 +92,7 @@ struct SherdDetection {
 };
 
 /// Something on the station that is not offered as a sherd to pick: too small or too large by
-/// perception.min/max_sherd_size, or not measurable. Said to the task layer so a batch that
+/// perception.min/max_sherd_size, not measurable, or only partly in view. Said to the task layer so a batch that
 /// leaves it on the mat says so instead of finishing as if the mat were empty.
 struct Leftover {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m] centre of its outline, on the surface
@@ -102,6 +102,9 @@ struct Leftover {
   /// taller than wide and at least perception.min_sherd_size tall: a sherd standing on its edge
   /// (leaning in a heap); pushed over, it lies flat
   bool on_edge = false;
+  /// only part of it in view: the image border cuts it (position and size are the part's); a
+  /// view centred on it sees it whole
+  bool cut_by_border = false;
   std::string why;  ///< one line naming the rule
 };
 
@@ -114,7 +117,7 @@ struct DetectionResult {
   Eigen::Vector4d plane = Eigen::Vector4d(0, 0, 1, 0);  ///< table plane in base_link, n.p + d = 0
   int plane_inliers = 0;
   int rejected_border = 0, rejected_size = 0, splits = 0;
-  std::vector<Leftover> leftovers;  ///< with depth only: what was seen whole but not offered
+  std::vector<Leftover> leftovers;  ///< with depth only: what was seen but not offered
 };
 
 }  // namespace rascal_perception

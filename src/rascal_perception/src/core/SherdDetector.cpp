@@ -287,10 +287,13 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
   stack.min_area_px = static_cast<int>(0.5 * std::pow(config_.min_sherd_size * ppm, 2));
   // something seen whole but not offered: where it lies and why, for the task layer to say
   // `measured`: the measurer's outline and height where it got that far (its width, from the
-  // depth, is the strip's own; the image box of a standing sherd also holds a side face)
-  auto leave = [&](const Blob& b, const std::string& why, const SherdDetection* measured = nullptr) {
+  // depth, is the strip's own; the image box of a standing sherd also holds a side face);
+  // `cut`: only part of it in view (its box says nothing about standing on its edge)
+  auto leave = [&](const Blob& b, const std::string& why, const SherdDetection* measured = nullptr,
+                   bool cut = false) {
     Leftover l;
     l.why = why;
+    l.cut_by_border = cut;
     l.length = std::max(b.box.size.width, b.box.size.height) / ppm;
     l.width = std::min(b.box.size.width, b.box.size.height) / ppm;
     if (!SherdMeasurer::intersect(view, r.plane, 0.0, b.box.center.x, b.box.center.y, l.position)) return;
@@ -305,7 +308,7 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
     l.height = topHeight(b, height);
     const bool strip = measured && measured->width > 0.0 && measured->height > measured->width;
     // a sherd on its edge is as tall as a pickable sherd is wide; a thick chip is not
-    l.on_edge = (l.height > l.width || strip) && l.height >= config_.min_sherd_size;
+    l.on_edge = !cut && (l.height > l.width || strip) && l.height >= config_.min_sherd_size;
     if (l.on_edge && l.why.find("edge") == std::string::npos) l.why += "; taller than wide: standing on its edge?";
     r.leftovers.push_back(std::move(l));
   };
@@ -315,8 +318,11 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
     for (const StackPart& part : parts) {
       if (!depth_mm.empty()) {
         const BlobCheck verdict = SherdSegmenter::check(part.blob, rgb.size(), checks);
-        if (verdict == BlobCheck::kCutByBorder) {  // another view of the survey sees it whole
+        if (verdict == BlobCheck::kCutByBorder) {
+          // another view of the survey may see it whole; if none does (a sherd across the mat's
+          // edge), the task layer looks again centred on the part
           ++stats.rejected_border;
+          leave(part.blob, "cut by the image border", nullptr, true);
           continue;
         }
         if (verdict != BlobCheck::kAccepted) {

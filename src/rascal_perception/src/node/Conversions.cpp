@@ -99,6 +99,7 @@ rascal_msgs::Leftover toLeftover(const Leftover& l) {
   m.yaw = l.yaw;
   m.height = l.height;
   m.on_edge = l.on_edge;
+  m.cut_by_border = l.cut_by_border;
   m.why = l.why;
   return m;
 }

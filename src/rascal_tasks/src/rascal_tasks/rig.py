@@ -55,8 +55,9 @@ class Observation:
 
 @dataclass
 class Leftover:
-    """Something perception saw whole at a station but does not offer as a sherd to pick (too
-    small or too large by perception.min/max_sherd_size, or not measurable), in base_link."""
+    """Something perception saw at a station but does not offer as a sherd to pick (too small or
+    too large by perception.min/max_sherd_size, not measurable, or only partly in view), in
+    base_link."""
 
     x: float
     y: float
@@ -67,6 +68,9 @@ class Leftover:
     yaw: float = 0.0  # [rad] its long side's direction
     height: float = 0.0  # [m] its top above the surface (0: not seen)
     on_edge: bool = False  # taller than wide: standing on its edge (singulation.topple)
+    # only part of it in view, the image border cuts it (position and size the part's): a view
+    # centred on it sees it whole (survey.look_at_cut_sherds)
+    cut_by_border: bool = False
 
     def distance_to(self, x: float, y: float) -> float:
         return math.hypot(self.x - x, self.y - y)

@@ -93,6 +93,7 @@ def leftover_from_msg(m) -> rig.Leftover:
         m.yaw,
         m.height,
         m.on_edge,
+        m.cut_by_border,
     )
 
 

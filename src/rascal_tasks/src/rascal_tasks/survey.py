@@ -3,12 +3,13 @@ and the states SURVEY and SURVEY_NEXT. No ROS in here.
 """
 
 import math
-from typing import List, Tuple
+from dataclasses import replace
+from typing import List, Optional, Tuple
 
 from rascal_workcell import urdf_model
 
 from rascal_tasks.batch import BatchState
-from rascal_tasks.rig import Observation
+from rascal_tasks.rig import Leftover, Observation
 from rascal_tasks.selection import SAME_SIZE, covered, in_pick_order, same_size
 from rascal_tasks.singulation import lay_flat
 
@@ -17,6 +18,13 @@ from rascal_tasks.singulation import lay_flat
 CAMERA_OFFSET = urdf_model.camera_offset()
 # Two detections closer than this are the same sherd seen from two survey poses.
 SAME_SHERD = 0.02
+# Looks of their own at sherds the image border cut in every survey view (one across the mat's
+# edge): each costs a move there (about 1 s), and a batch meets a few such sherds at most.
+MAX_EXTRA_LOOKS = 3
+# How much nearer the base than a cut sherd the camera may look from when it cannot be over it
+# at the survey height (the mat's far corners): the sherd then lies off the image's centre, by
+# less than the view's half-height (~0.11 m) less half the longest sherd.
+LOOK_BACK = 0.06
 
 
 def lawnmower(
@@ -141,6 +149,66 @@ def account_for_vanished(b, found: List[Observation]):
     b.taken_since_survey = []
 
 
+def view_over(b, x: float, y: float) -> Optional[Tuple[float, float]]:
+    """Where the wrist camera can look down from the survey height to see (x, y) near its
+    image's centre: over it, else up to LOOK_BACK nearer the base (the mat's far corners are
+    out of reach at that height), or None."""
+    from rascal_tasks.config import top_down_reachable  # config imports this module
+
+    z = b.pickup.surface_z + b.config["survey"]["z"]
+    r = math.hypot(x, y)
+    for k in range(7):
+        shrink = max(0.0, r - LOOK_BACK * k / 6) / r
+        ex, ey, _ = gripper_for_camera_over(x * shrink, y * shrink)
+        if top_down_reachable(ex, ey, z):
+            return x * shrink, y * shrink
+    return None
+
+
+def inside(part: Leftover, whole) -> bool:
+    """Whether `part`'s centre lies within a sherd (or leftover) seen whole: within half its
+    length of its centre."""
+    return any(o.distance_to(part.x, part.y) <= o.length / 2 for o in whole)
+
+
+def look_at_cut_sherds(b, look, found: List[Observation], parts: List[Leftover]):
+    """Sherds the image border cut in every view so far (a sherd across the mat's edge lies
+    partly beyond the lawnmower's views, and perception offers only what it sees whole): each is
+    looked at from a view of its own (`look(x, y)`, which adds to `found`, `b.leftovers` and
+    `parts`), at most MAX_EXTRA_LOOKS. One still cut after it, or out of the camera's reach, is
+    left for a person as a leftover, said at the batch's end."""
+    looked: List[Tuple[float, float]] = []
+    unseen: List[Leftover] = []
+    for _ in range(MAX_EXTRA_LOOKS + 1):
+        cut = [
+            p
+            for p in parts
+            if not inside(p, found)
+            and not inside(p, b.leftovers)
+            and all(p.distance_to(u.x, u.y) > SAME_SHERD for u in unseen)
+        ]
+        if not cut:
+            break
+        p = cut[0]
+        at = view_over(b, p.x, p.y)
+        if (
+            at is None
+            or len(looked) == MAX_EXTRA_LOOKS
+            or any(math.hypot(at[0] - x, at[1] - y) <= SAME_SHERD for x, y in looked)
+        ):
+            unseen.append(p)  # out of reach, or still cut from a view of its own
+            continue
+        looked.append(at)
+        b.log(
+            "survey: a sherd at (%.3f, %.3f) m is cut by the image border in every view: "
+            "looking from (%.3f, %.3f) m" % (p.x, p.y, at[0], at[1])
+        )
+        look(*at)
+    for p in unseen:
+        why = "only part of it seen (the image border cut it in every view the arm reaches)"
+        b.leftovers.append(replace(p, why=why, cut_by_border=False))
+
+
 def merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
     """Add to `found` the detections of `new` that are not a sherd already in it."""
     for o in new:
@@ -153,20 +221,30 @@ def survey_pickup_area(b) -> List[Observation]:
     """The lawnmower over the pickup area, views merged. Sherds the gripper failed on
     again and again are left out: they stay where they are, for a person. What the views saw
     on the mat but perception does not offer as sherds (too small, too large) is kept in
-    `b.leftovers`, merged the same way: a batch that ends with them there says so."""
+    `b.leftovers`, merged the same way: a batch that ends with them there says so. A sherd the
+    image border cut in every view gets a look of its own (look_at_cut_sherds)."""
     found: List[Observation] = []
+    parts: List[Leftover] = []  # what the image border cut, lying on the mat
     b.leftovers = []
-    for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size, b.config["survey"]["step"]):
+
+    def look(x, y):
         merge(found, survey_at(b, b.pickup, x, y))
+        new = b.rig.perception.leftovers(b.pickup.name)
+        parts.extend(lo for lo in new if lo.cut_by_border and b.pickup.area.has((lo.x, lo.y)))
         merge(
             b.leftovers,
             [
                 lo
-                for lo in b.rig.perception.leftovers(b.pickup.name)
-                if on_the_mat(b.pickup.area, lo)
+                for lo in new
+                if not lo.cut_by_border
+                and on_the_mat(b.pickup.area, lo)
                 and all(o.distance_to(lo.x, lo.y) > SAME_SHERD for o in found)
             ],
         )
+
+    for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size, b.config["survey"]["step"]):
+        look(x, y)
+    look_at_cut_sherds(b, look, found, parts)
     # a sherd seen whole in a later view is not a leftover of an earlier one
     b.leftovers = [
         lo for lo in b.leftovers if all(o.distance_to(lo.x, lo.y) > SAME_SHERD for o in found)

@@ -1,0 +1,104 @@
+"""Core tests of the survey's rule for sherds the image border cuts (`survey.look_at_cut_sherds`):
+a sherd across the mat's edge lies partly beyond every lawnmower view, perception offers only
+what it sees whole, and such a sherd must be looked at from a view of its own or said. Run
+against the in-memory rig of `fake_rig.py` (its view a circle; `World.view_cuts` makes its edge
+cut sherds as the image border does)."""
+
+import math
+
+import pytest
+from fake_rig import Sherd, World, run_batch, shipped_config
+
+from rascal_tasks.run_batch import what_is_left
+from rascal_tasks.survey import LOOK_BACK, MAX_EXTRA_LOOKS, describe_leftover, lawnmower, view_over
+
+
+@pytest.fixture
+def config():
+    return shipped_config()
+
+
+def _cutting_world(config, sherds, radius=0.11):
+    world = World(config, sherds)
+    world.view_radius, world.view_cuts = radius, True
+    return world
+
+
+def _survey_looks(world, config):
+    """The camera positions of the survey moves (gripper at the survey height)."""
+    z = config.stations["pickup"].surface_z + config["survey"]["z"]
+    return [m for m in world.moves if abs(m[2] - z) < 1e-9]
+
+
+def test_a_sherd_across_the_far_corner_of_the_mat_is_looked_at_again_and_recorded(config):
+    # (0.30, 0.325): the mat ends at (0.31, 0.33); the lawnmower's nearest view sees it cut
+    across = Sherd("across", 0.30, 0.325, 0.06, 0.045)
+    world = _cutting_world(config, [Sherd("a", 0.10, 0.22), across])
+    outcome, batch, rec = run_batch(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert across.station == "discard"
+    assert batch.leftovers == [] and what_is_left(batch, []) == ""
+
+
+def test_without_the_look_of_its_own_the_cut_sherd_is_never_offered(config, monkeypatch):
+    # the rule above is what records it: with no extra look it stays on the mat, unsaid
+    import rascal_tasks.survey as survey
+
+    monkeypatch.setattr(survey, "MAX_EXTRA_LOOKS", 0)
+    across = Sherd("across", 0.30, 0.325, 0.06, 0.045)
+    world = _cutting_world(config, [Sherd("a", 0.10, 0.22), across])
+    outcome, batch, rec = run_batch(config, world)
+    assert rec.status() == {1: "done"} and across.station == "pickup"
+    # ... but it is said, not left silently: a part no view saw whole is a leftover
+    assert len(batch.leftovers) == 1
+    assert "only part of it seen" in describe_leftover(batch.leftovers[0])
+
+
+def test_a_sherd_no_view_sees_whole_is_left_for_a_person_and_said(config):
+    # longer than the view is wide: cut from the lawnmower's view and from one centred on it
+    long = Sherd("long", 0.285, 0.25, 0.24, 0.05)
+    world = _cutting_world(config, [Sherd("a", 0.10, 0.22), long])
+    outcome, batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    assert long.station == "pickup"
+    assert len(batch.leftovers) == 1
+    lo = batch.leftovers[0]
+    assert not lo.cut_by_border and "only part of it seen" in lo.why
+    assert math.hypot(lo.x - long.x, lo.y - long.y) < long.length / 2
+    assert "1 object on the pickup mat not taken as sherds" in what_is_left(batch, [])
+    # each survey looked at it at most MAX_EXTRA_LOOKS times beyond its lawnmower
+    area = config.stations["pickup"].area
+    views = len(lawnmower(area.center, area.size, config["survey"]["step"]))
+    surveys = len(_survey_looks(world, config))
+    assert surveys <= (views + MAX_EXTRA_LOOKS) * (1 + config["recovery"]["max_empty_surveys"]) + 2
+
+
+def test_sherds_seen_whole_in_another_view_cost_no_extra_look(config):
+    # every sherd of the mat's middle is cut by one view's edge and whole in another
+    sherds = [Sherd("a", 0.10, 0.22), Sherd("b", 0.16, 0.25), Sherd("c", 0.22, 0.28)]
+    plain = World(config, [Sherd(s.name, s.x, s.y) for s in sherds])
+    run_batch(config, plain)
+    world = _cutting_world(config, sherds, radius=0.15)
+    outcome, batch, rec = run_batch(config, world)
+    assert rec.status() == {1: "done", 2: "done", 3: "done"}
+    assert len(_survey_looks(world, config)) == len(_survey_looks(plain, config))
+
+
+def test_the_look_at_a_far_corner_is_from_the_nearest_pose_the_arm_reaches(config):
+    from rascal_tasks.config import top_down_reachable
+    from rascal_tasks.survey import gripper_for_camera_over
+
+    class B:
+        pickup = config.stations["pickup"]
+
+    B.config = config
+    z = B.pickup.surface_z + config["survey"]["z"]
+    x, y = 0.305, 0.325  # out of reach at the survey height, camera over it
+    assert not top_down_reachable(*gripper_for_camera_over(x, y)[:2], z)
+    at = view_over(B, x, y)
+    assert at is not None
+    assert top_down_reachable(*gripper_for_camera_over(*at)[:2], z)
+    assert 0 < math.hypot(at[0] - x, at[1] - y) <= LOOK_BACK + 1e-9
+    assert abs(math.atan2(at[1], at[0]) - math.atan2(y, x)) < 1e-9  # nearer the base, on its line
+    assert view_over(B, 0.16, 0.25) == pytest.approx((0.16, 0.25))  # over it where it can
