@@ -12,6 +12,7 @@ import yaml
 from fake_rig import Recorder, Sherd, World
 
 from rascal_tasks import workflow
+from rascal_tasks.batch import PUSHED_OFF, SLIPPED_AWAY
 from rascal_tasks.catalogue.errors import CatalogueError
 from rascal_tasks.config import config_from_dict
 from rascal_tasks.failures import LOSE_SHERD, STOP, SherdFailure, classify
@@ -216,8 +217,31 @@ def test_a_sherd_that_slips_out_while_lifted_and_vanishes_is_said(config):
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished"
     assert rec.status() == {1: "done"}
-    assert batch.slipped_away == [(0.25, 0.30)]
+    assert batch.not_seen(SLIPPED_AWAY) == [(0.25, 0.30)]
+    # said once: not also as a sherd near the mat's edge pushed off by a grasp beside it
+    assert batch.not_seen(PUSHED_OFF) == []
     assert "1 sherd slipped out of the fingers while lifted" in what_is_left(batch, [])
+
+
+def test_a_slipped_sherd_seen_by_a_later_survey_is_no_longer_said(config):
+    # in a heap one that fell back may lie under another until that one is picked: here it is
+    # out of view for the survey after the slip and back where it fell for the one after that
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.lift_slips["b"] = None
+    b = world.sherds[1]
+    said = []
+
+    def log(line):
+        said.append(line)
+        if "slipped_away" in line:
+            world.put(b, 0.26, 0.30)  # seen by the next survey
+
+    rec = Recorder()
+    batch = workflow.Batch(config, world.rig(), rec, context="T", log=log)
+    assert workflow.build_machine(batch).execute() == "finished"
+    assert rec.status() == {1: "done", 2: "done"} and b.station == "discard"
+    assert batch.not_seen_again == [] and what_is_left(batch, []) == ""
+    assert any(line.startswith("batch seen_again:") for line in said), said
 
 
 def test_a_sherd_that_slips_out_while_lifted_and_falls_near_is_picked_again(config):
@@ -226,7 +250,9 @@ def test_a_sherd_that_slips_out_while_lifted_and_falls_near_is_picked_again(conf
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished"
     assert rec.status() == {1: "done", 2: "done"}
-    assert batch.slipped_away == [] and [(o.x, o.y) for o in batch.lift_slips] == [(0.25, 0.30)]
+    assert batch.not_seen(SLIPPED_AWAY) == [] and [(o.x, o.y) for o in batch.lift_slips] == [
+        (0.25, 0.30)
+    ]
     assert what_is_left(batch, []) == ""
 
 
@@ -244,7 +270,7 @@ def test_a_sherd_that_slips_away_from_a_heap_is_said_though_others_lie_near(conf
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished"
     assert rec.status() == {1: "done", 2: "done"}
-    assert batch.slipped_away == [(0.25, 0.30)]
+    assert batch.not_seen(SLIPPED_AWAY) == [(0.25, 0.30)]
 
 
 def test_a_sherd_pushed_off_the_mat_by_a_grasp_beside_it_is_said(config):
@@ -254,13 +280,15 @@ def test_a_sherd_pushed_off_the_mat_by_a_grasp_beside_it_is_said(config):
     world.knock_off["a"] = ("b", (0.12, 0.37))
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished" and rec.status() == {1: "done"}
-    assert batch.vanished == [pytest.approx((0.12, 0.31))]
+    assert batch.not_seen(PUSHED_OFF) == [pytest.approx((0.12, 0.31))]
     # shoved off by the grasp of a sherd lying right beside it (within the search radius):
     # that neighbour taken does not count for it
     world = World(config, [Sherd("a", 0.12, 0.27), Sherd("b", 0.12, 0.31)])
     world.knock_off["a"] = ("b", (0.12, 0.37))
     outcome, batch, rec = _run(config, world)
-    assert rec.status() == {1: "done"} and batch.vanished == [pytest.approx((0.12, 0.31))]
+    assert rec.status() == {1: "done"} and batch.not_seen(PUSHED_OFF) == [
+        pytest.approx((0.12, 0.31))
+    ]
     # in a heap smaller sherds always lie near: one of them (here left on the mat, its grasps
     # failing) is not taken for it
     small = Sherd("c", 0.15, 0.29, 0.025, 0.02, mass=0.006)
@@ -269,7 +297,7 @@ def test_a_sherd_pushed_off_the_mat_by_a_grasp_beside_it_is_said(config):
     world.bad_holds["c"] = 1000
     outcome, batch, rec = _run(config, world)
     assert rec.status() == {1: "done"} and small.station == "pickup"
-    assert batch.vanished == [pytest.approx((0.12, 0.31))]
+    assert batch.not_seen(PUSHED_OFF) == [pytest.approx((0.12, 0.31))]
     assert "1 sherd seen near the mat's edge, not picked up and not seen again" in what_is_left(
         batch, []
     )
@@ -280,13 +308,13 @@ def test_a_sherd_nudged_by_a_grasp_beside_it_or_picked_is_not_said(config):
     world.knock_off["a"] = ("b", (0.13, 0.29))  # nudged 22 mm, still on the mat
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
-    assert batch.vanished == [] and what_is_left(batch, []) == ""
+    assert batch.not_seen(PUSHED_OFF) == [] and what_is_left(batch, []) == ""
     # one in the middle of the mat moved far (under another, or shoved along) is not said: the
     # mat still holds it
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.16, 0.25)])
     world.knock_off["a"] = ("b", (0.40, 0.0))  # gone from the mat, but not from near its edge
     outcome, batch, rec = _run(config, world)
-    assert outcome == "finished" and batch.vanished == []
+    assert outcome == "finished" and batch.not_seen(PUSHED_OFF) == []
 
 
 def test_an_arm_timeout_parks_and_stops_with_nothing_else_recorded(config):

@@ -5,7 +5,8 @@ progress callback are injected.
 
 import contextlib
 import threading
-from typing import Callable, List, Optional
+from dataclasses import dataclass
+from typing import Callable, List, Optional, Tuple
 
 from rascal_tasks.catalogue.errors import CatalogueError
 from rascal_tasks.failures import LOSE_SHERD, SherdFailure, classify
@@ -21,6 +22,24 @@ except ImportError:  # pragma: no cover - depends on the machine
 
 # Events after which the machine ends the batch: the last one is why (batch.stop_reason).
 STOPPING_EVENTS = ("rig_error", "stopped", "database_error", "park_failed")
+
+
+# Why a sherd of the bag was looked for and not seen again (the batch event's kind and the key of
+# the batch_ended log): it slipped out of the fingers while lifted; it lay near the mat's edge
+# and a grasp beside it may have pushed it off.
+SLIPPED_AWAY = "slipped_away"
+PUSHED_OFF = "not_seen_again"
+
+
+@dataclass(frozen=True)
+class NotSeenAgain:
+    """A sherd on the pickup mat, never recorded, that the survey after it did not see again:
+    it may lie beside the mat, for a person to look for."""
+
+    kind: str  # SLIPPED_AWAY or PUSHED_OFF
+    x: float  # [m] where it was last seen, in base_link
+    y: float
+    seen: Observation  # how it was seen there (its size)
 
 
 class Batch:
@@ -60,8 +79,6 @@ class Batch:
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
         self.lift_slips: List[Observation] = []  # grasped sherds that slipped out while lifted
         self.unchecked_slips: List[Observation] = []  # ... not yet looked for by a survey
-        # where one slipped so and was not seen near there after: it may lie off the mat
-        self.slipped_away: List[tuple] = []
         self.pushed = set()  # rounded (x, y) where a sherd was pushed apart (singulation.py)
         self.pushed_to: List[tuple] = []  # ((x, y) where it should lie now, its Observation)
         self.pending: List[Observation] = []
@@ -74,9 +91,8 @@ class Batch:
         self.seen: List[Observation] = []  # the last survey of the pickup area, merged
         # (x, y) where sherds were taken off the pickup mat since that survey
         self.taken_since_survey: List[tuple] = []
-        # where a sherd of the last survey lay near the mat's edge, not taken and not seen
-        # again by the next: a grasp beside it may have pushed it off the mat
-        self.vanished: List[tuple] = []
+        # sherds that slipped while lifted, or lay near the mat's edge, and were not seen again
+        self.not_seen_again: List[NotSeenAgain] = []
         # what the last survey saw on the mat but perception did not offer (rig.Leftover)
         self.leftovers: List = []
         self.empty_surveys = 0
@@ -108,6 +124,10 @@ class Batch:
             self.timings.add(name, spent - self._phases.pop())
             if self._phases:
                 self._phases[-1] += spent
+
+    def not_seen(self, kind: str) -> List[Tuple[float, float]]:
+        """Where the sherds not seen again for `kind` (SLIPPED_AWAY, PUSHED_OFF) were last seen."""
+        return [(u.x, u.y) for u in self.not_seen_again if u.kind == kind]
 
     def event(self, sherd: Optional[SherdRecord], kind: str, detail: str = ""):
         """Log what happened; a sherd's events also go into its catalogue notes."""
@@ -173,7 +193,7 @@ class Batch:
 
     def route(self) -> list:
         """The stations a sherd is carried to and set down at, in order (config Stations)."""
-        return [p.station for p in self.plugins if not p.stays]
+        return [self.config.stations[n] for n in self.config.route()]
 
     def next_stays(self, i: int):
         """The plug-in after station `i` when it works on the sherd where `i` left it (`stays`:

@@ -127,6 +127,11 @@ class Config:
         rule takes the sherd, in place of the discard box)."""
         return [n for n, s in self.stations.items() if s.type not in ("pickup", "bin")]
 
+    def route(self) -> List[str]:
+        """The stations a sherd is carried to and set down at, in order: station_order without
+        a camera over the scale (`over_scale`), which works where the scale has the sherd."""
+        return [n for n in self.station_order() if not self.stations[n].over_scale]
+
     def bins(self) -> List[Tuple[str, Rule]]:
         """The sorting bins (name, rule) in the order their rules are tried."""
         return [(n, s.rule) for n, s in self.stations.items() if s.type == "bin"]

@@ -178,10 +178,8 @@ def start_steps(cfg: Config) -> List[Step]:
     background (resume.Calibrate), the first survey."""
     pickup, travel = cfg.stations["pickup"], cfg["arm"]["travel_z"]
     steps = [Step("home", (*pickup.area.center, travel))]
-    for name in cfg.station_order():
+    for name in cfg.route():  # the camera over the scale is learnt with the scale
         st = cfg.stations[name]
-        if st.over_scale:
-            continue  # the camera over the scale: learnt with the scale
         ex, ey, _ = gripper_for_camera_over(*st.place_at)
         z = st.surface_z + cfg["survey"]["z"]
         steps.append(Step("learn " + name, (ex, ey, z), wait=cfg["survey"]["settle_time"]))

@@ -44,9 +44,11 @@ class Pickup(BatchState):
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
         # again (survey.account_for_slips), unless the retry took it at once
         b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
-        if held:
-            # the survey's sherd itself (a neighbour its grasp shoves lies within the radius)
+        if held or len(b.lift_slips) > slips:
+            # the survey's sherd itself left the mat (a neighbour its grasp shoves lies within
+            # the radius); one that slipped while lifted is the slip check's to look for
             b.taken_since_survey.append((surveyed.x, surveyed.y))
+        if held:
             if b.renumber is not None:  # two were put back: this one takes over that number
                 b.sherd, b.renumber = b.renumber, None
                 b.sherd.taken_over(o, b.pickup)

@@ -6,7 +6,8 @@ from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.survey import survey_at, survey_pickup_area
+from rascal_tasks.selection import same_size
+from rascal_tasks.survey import SAME_SHERD, survey_at, survey_pickup_area
 
 
 def unlikeness(c: Observation, length: float, width: float, ref) -> float:
@@ -72,7 +73,14 @@ class Recover(BatchState):
         )
         s.grasped_as(o, station)
         if station is b.pickup:
-            b.taken_since_survey.append((o.x, o.y))
+            # the edge check (survey.account_for_vanished) asks after the last survey's own
+            # sherds: one of them was taken only if `o` is it (a look here sees afresh, and a
+            # neighbour of the spot it fell on must not count as taken)
+            b.taken_since_survey += [
+                (c.x, c.y)
+                for c in b.seen
+                if c.distance_to(o.x, o.y) <= SAME_SHERD and same_size(c, o)
+            ][:1]
         if station is b.pickup and s.station_index < 0:
             # Picked afresh from the pickup area: what is in the gripper now is what gets measured.
             s.seen(o, b.pickup)

@@ -79,7 +79,7 @@ class Calibrate(BatchState):
         for plugin in b.plugins:
             st = plugin.station
             if plugin.stays:
-                continue  # it sees the station before: learnt there
+                continue  # it sees the station before: learnt there (config.route)
             camera_over(b, st, *st.place_at)
             if not plugin.release_from_above:
                 seen = b.rig.perception.detect_if_calibrated(st.name)

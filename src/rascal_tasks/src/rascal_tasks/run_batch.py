@@ -18,6 +18,7 @@ import psycopg2
 import rospy
 
 from rascal_tasks import exit_codes
+from rascal_tasks.batch import PUSHED_OFF, SLIPPED_AWAY
 from rascal_tasks.catalogue import Catalogue, ConnectionLostError, ImageArchive
 from rascal_tasks.catalogue.central import ContextClaimed
 from rascal_tasks.catalogue.context_batches import (
@@ -279,8 +280,7 @@ class Run:
             )
             if done:  # what the batch before learnt about the mat
                 batch.unpickable = done[-1].unpickable
-                batch.slipped_away = done[-1].slipped_away
-                batch.vanished = done[-1].vanished
+                batch.not_seen_again = done[-1].not_seen_again
                 batch.misses = done[-1].misses
                 batch.pushed = done[-1].pushed
                 batch.pushed_to = done[-1].pushed_to
@@ -326,8 +326,10 @@ class Run:
                     "outcome": outcome,
                     # what the person is told to look at stays with the context's history
                     "not_taken": [describe_leftover(lo) for lo in done[-1].leftovers],
-                    "slipped_away": [list(xy) for xy in done[-1].slipped_away],
-                    "not_seen_again": [list(xy) for xy in done[-1].vanished],
+                    **{
+                        kind: [list(xy) for xy in done[-1].not_seen(kind)]
+                        for kind in NOT_SEEN_AGAIN
+                    },
                 },
             )
         except psycopg2.Error as e:  # not logged: the next run resumes, which loses nothing
@@ -473,6 +475,23 @@ def make_rig(cfg, stop=None) -> Rig:
     )
 
 
+# What a person is told of the sherds not seen again (batch.NotSeenAgain), by kind: the count's
+# phrase in the closing line, and each one's own line.
+NOT_SEEN_AGAIN = {
+    SLIPPED_AWAY: (
+        "slipped out of the fingers while lifted and not seen again (it may lie beside the "
+        "mat: if every sherd of the bag is recorded, it was found again)",
+        "slipped out of the fingers while lifted at (%.3f, %.3f) m, not seen again",
+    ),
+    PUSHED_OFF: (
+        "seen near the mat's edge, not picked up and not seen again (a grasp beside it may "
+        "have pushed it off the mat)",
+        "seen near the mat's edge at (%.3f, %.3f) m, not picked up, not seen again: look "
+        "beside the mat",
+    ),
+}
+
+
 def what_is_left(batch, rows) -> str:
     """What a person must see to after a finished batch ('' when the bag is complete): sherds
     left on the mat, objects on it perception does not offer as sherds, and rows of the context
@@ -481,16 +500,7 @@ def what_is_left(batch, rows) -> str:
     rows = rows or []
     counts = (
         (len(batch.unpickable), "left on the pickup mat (could not be picked up)"),
-        (
-            len(batch.slipped_away),
-            "slipped out of the fingers while lifted and not seen again (it may lie beside the "
-            "mat: if every sherd of the bag is recorded, it was found again)",
-        ),
-        (
-            len(batch.vanished),
-            "seen near the mat's edge, not picked up and not seen again (a grasp beside it may "
-            "have pushed it off the mat)",
-        ),
+        *((len(batch.not_seen(kind)), what) for kind, (what, _) in NOT_SEEN_AGAIN.items()),
         (sum(r["status"] == "lost" for r in rows), "recorded lost"),
         (
             sum(r["status"] not in ("lost", "picked") and r.get("mass_g") is None for r in rows),
@@ -532,13 +542,8 @@ def print_summary(batches, rows, outcome, wall_seconds):
         print("left in the pickup area (could not be picked up): sherd at (%.3f, %.3f) m" % (x, y))
     for lo in batches[-1].leftovers:
         print(describe_leftover(lo))
-    for x, y in batches[-1].slipped_away:
-        print("slipped out of the fingers while lifted at (%.3f, %.3f) m, not seen again" % (x, y))
-    for x, y in batches[-1].vanished:
-        print(
-            "seen near the mat's edge at (%.3f, %.3f) m, not picked up, not seen again: look "
-            "beside the mat" % (x, y)
-        )
+    for u in batches[-1].not_seen_again:
+        print(NOT_SEEN_AGAIN[u.kind][1] % (u.x, u.y))
     state_times = {}
     for b in batches:
         for k, v in b.state_times.items():

@@ -8,7 +8,7 @@ from typing import List, Optional, Tuple
 
 from rascal_workcell import urdf_model
 
-from rascal_tasks.batch import BatchState
+from rascal_tasks.batch import PUSHED_OFF, SLIPPED_AWAY, BatchState, NotSeenAgain
 from rascal_tasks.rig import Leftover, Observation
 from rascal_tasks.selection import SAME_SIZE, covered, in_pick_order, same_size
 from rascal_tasks.singulation import lay_flat
@@ -89,25 +89,49 @@ def describe_leftover(lo) -> str:
     )
 
 
+def look_for(b, kind: str, expected, found: List[Observation], alike, say):
+    """Each of `expected` ((x, y, Observation)) must be seen again by this survey: something
+    `alike(c, o)` among `found` and the survey's leftovers within recovery.search_radius of
+    (x, y). Each not seen is a batch event `kind` (`say(o, radius)`: its detail) and a
+    NotSeenAgain in the batch's summary: it may lie beside the mat. One of those seen by a
+    later survey is no longer said (in a heap a sherd that fell back may lie under another
+    until that one is picked)."""
+    radius = b.config["recovery"]["search_radius"]
+    seen = list(found) + list(b.leftovers)
+
+    def again(x, y, o):
+        return any(c.distance_to(x, y) < radius and alike(c, o) for c in seen)
+
+    for u in [u for u in b.not_seen_again if u.kind == kind and again(u.x, u.y, u.seen)]:
+        b.not_seen_again.remove(u)
+        b.event(
+            None,
+            "seen_again",
+            "the sherd not seen again (%s) at (%.3f, %.3f) m is seen "
+            "there now" % (kind, u.x, u.y),
+        )
+    for x, y, o in expected:
+        if not again(x, y, o):
+            b.not_seen_again.append(NotSeenAgain(kind, x, y, o))
+            b.event(None, kind, say(o, radius))
+
+
 def account_for_slips(b, found: List[Observation]):
     """Sherds that slipped out of the fingers while lifted (pickup.py) have no number yet, so
     no row would miss one. Each must be seen again by the survey after it: a sherd of its size
     within recovery.search_radius of where it was held (others always lie near in a heap).
     One not seen may lie beside the mat: said, and the batch ends incomplete."""
-    radius = b.config["recovery"]["search_radius"]
-    seen = list(found) + list(b.leftovers)
-    for o in b.unchecked_slips:
-        x, y = o.grasp_x, o.grasp_y
-        if any(c.distance_to(x, y) < radius and same_size(c, o) for c in seen):
-            continue
-        b.slipped_away.append((x, y))
-        b.event(
-            None,
-            "slipped_away",
-            "a %.0f x %.0f mm sherd slipped out of the fingers while lifted at (%.3f, %.3f) m "
-            "and the survey after it sees none of its size within %.0f mm of there: it may lie "
-            "beside the mat" % (o.length * 1000, o.width * 1000, x, y, radius * 1000),
-        )
+    look_for(
+        b,
+        SLIPPED_AWAY,
+        [(o.grasp_x, o.grasp_y, o) for o in b.unchecked_slips],
+        found,
+        same_size,
+        lambda o, radius: "a %.0f x %.0f mm sherd slipped out of the fingers while lifted at "
+        "(%.3f, %.3f) m and the survey after it sees none of its size within %.0f mm of there: "
+        "it may lie beside the mat"
+        % (o.length * 1000, o.width * 1000, o.grasp_x, o.grasp_y, radius * 1000),
+    )
     b.unchecked_slips = []
 
 
@@ -127,25 +151,23 @@ def account_for_vanished(b, found: List[Observation]):
     may have been pushed off the mat by a grasp beside it: said, and the batch ends
     incomplete (a sherd recorded nowhere and said nowhere is the one failure a person would
     never notice)."""
-    radius = b.config["recovery"]["search_radius"]
-    for o in b.seen:
-        if not near_the_edge(b.pickup.area, o):
-            continue  # moved, or under another: the mat still holds it
-        if any(math.hypot(o.x - x, o.y - y) <= SAME_SHERD for x, y in b.taken_since_survey):
-            continue  # taken itself (a neighbour taken beside it does not count)
-        as_long = (1.0 - SAME_SIZE) * o.length
-        if any(c.distance_to(o.x, o.y) < radius and c.length >= as_long for c in found):
-            continue
-        if any(lo.distance_to(o.x, o.y) < radius for lo in b.leftovers):
-            continue
-        b.vanished.append((o.x, o.y))
-        b.event(
-            None,
-            "not_seen_again",
-            "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge was not picked "
-            "up and is not seen within %.0f mm of there since: a grasp beside it may have "
-            "pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
-        )
+    near = [
+        (o.x, o.y, o)
+        for o in b.seen
+        if near_the_edge(b.pickup.area, o)  # elsewhere: moved, or under another, still on the mat
+        # taken itself (a neighbour taken beside it does not count)
+        and all(math.hypot(o.x - x, o.y - y) > SAME_SHERD for x, y in b.taken_since_survey)
+    ]
+    look_for(
+        b,
+        PUSHED_OFF,
+        near,
+        found,
+        lambda c, o: isinstance(c, Leftover) or c.length >= (1.0 - SAME_SIZE) * o.length,
+        lambda o, radius: "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge "
+        "was not picked up and is not seen within %.0f mm of there since: a grasp beside it may "
+        "have pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
+    )
     b.taken_since_survey = []
 
 
