@@ -199,36 +199,32 @@ def look_at_cut_sherds(b, look, found: List[Observation], parts: List[Leftover])
     looked at from a view of its own (`look(x, y)`, which adds to `found`, `b.leftovers` and
     `parts`), at most MAX_EXTRA_LOOKS. One still cut after it, or out of the camera's reach, is
     left for a person as a leftover, said at the batch's end."""
+
+    def unexplained():
+        return [p for p in parts if not inside(p, found) and not inside(p, b.leftovers)]
+
     looked: List[Tuple[float, float]] = []
-    unseen: List[Leftover] = []
-    for _ in range(MAX_EXTRA_LOOKS + 1):
-        cut = [
-            p
-            for p in parts
-            if not inside(p, found)
-            and not inside(p, b.leftovers)
-            and all(p.distance_to(u.x, u.y) > SAME_SHERD for u in unseen)
+    while len(looked) < MAX_EXTRA_LOOKS:
+        # a view not yet taken (one already taken saw it cut again: too long for a view)
+        views = [
+            (p, at)
+            for p, at in ((p, view_over(b, p.x, p.y)) for p in unexplained())
+            if at is not None
+            and all(math.hypot(at[0] - x, at[1] - y) > SAME_SHERD for x, y in looked)
         ]
-        if not cut:
+        if not views:
             break
-        p = cut[0]
-        at = view_over(b, p.x, p.y)
-        if (
-            at is None
-            or len(looked) == MAX_EXTRA_LOOKS
-            or any(math.hypot(at[0] - x, at[1] - y) <= SAME_SHERD for x, y in looked)
-        ):
-            unseen.append(p)  # out of reach, or still cut from a view of its own
-            continue
+        p, at = views[0]
         looked.append(at)
         b.log(
             "survey: a sherd at (%.3f, %.3f) m is cut by the image border in every view: "
             "looking from (%.3f, %.3f) m" % (p.x, p.y, at[0], at[1])
         )
         look(*at)
-    for p in unseen:
-        why = "only part of it seen (the image border cut it in every view the arm reaches)"
-        b.leftovers.append(replace(p, why=why, cut_by_border=False))
+    for p in unexplained():  # out of reach, too long for a view, or past the looks
+        if not inside(p, b.leftovers):
+            why = "only part of it seen (the image border cut it in every view the arm reaches)"
+            b.leftovers.append(replace(p, why=why, cut_by_border=False))
 
 
 def merge(found: List[Observation], new: List[Observation]) -> List[Observation]:
