@@ -426,3 +426,30 @@ def test_two_put_back_together_that_stay_one_on_the_other_are_taken_apart(config
     # two places: the pair's, and the one the top sherd was taken to
     assert notes and all(len(re.findall(r"\(([-\d.]+), ([-\d.]+)\) m", n)) == 2 for n in notes)
     assert all(s.station == "discard" for s in world.sherds)
+
+
+def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(config, monkeypatch):
+    # taken from the top of a heap (lying 20 mm up on another), set down on the scale it lies
+    # on the pan: the blind grasp there closes low over the pan, not 20 mm above it (which
+    # closed on nothing, and a look and a second grasp followed at every station)
+    import rascal_tasks.manipulation as manipulation
+
+    grasps = []
+    real = manipulation.grasp
+
+    def counted(b, o, station):
+        held = real(b, o, station)
+        grasps.append((station.name, held))
+        return held
+
+    monkeypatch.setattr(manipulation, "grasp", counted)
+    monkeypatch.setattr("rascal_tasks.station_states.grasp", counted)
+    top = Sherd("top", 0.16, 0.25)
+    top.support = 0.02
+    world = World(config, [top])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    assert all(held for _, held in grasps), grasps
+    # one grasp at each station it is taken from: the pickup mat, and each it is set down at
+    # but the discard box
+    assert [name for name, _ in grasps] == ["pickup"] + config.route()[:-1]

@@ -5,12 +5,21 @@ against the in-memory rig of `fake_rig.py` (its view a circle; `World.view_cuts`
 cut sherds as the image border does)."""
 
 import math
+from types import SimpleNamespace
 
 import pytest
 from fake_rig import Sherd, World, run_batch, shipped_config
 
+from rascal_tasks.rig import Observation
 from rascal_tasks.run_batch import what_is_left
-from rascal_tasks.survey import LOOK_BACK, MAX_EXTRA_LOOKS, describe_leftover, lawnmower, view_over
+from rascal_tasks.survey import (
+    LOOK_BACK,
+    MAX_EXTRA_LOOKS,
+    describe_leftover,
+    lawnmower,
+    taken_off_the_mat,
+    view_over,
+)
 
 
 @pytest.fixture
@@ -102,3 +111,22 @@ def test_the_look_at_a_far_corner_is_from_the_nearest_pose_the_arm_reaches(confi
     assert 0 < math.hypot(at[0] - x, at[1] - y) <= LOOK_BACK + 1e-9
     assert abs(math.atan2(at[1], at[0]) - math.atan2(y, x)) < 1e-9  # nearer the base, on its line
     assert view_over(B, 0.16, 0.25) == pytest.approx((0.16, 0.25))  # over it where it can
+
+
+def _seen(x, y, length=0.04):
+    return Observation(x, y, 0.0, length, 0.03, 0.01, x, y, 0.01, 0.0, 0.04)
+
+
+def test_the_sherd_counted_taken_is_the_one_grasped_not_the_one_looked_for():
+    # heap seed 36: a survey saw A partly under another; a fresh look for a neighbour X took A,
+    # uncovered since (its centre 1 cm on); A must count as taken, X (still there) not
+    a, x = _seen(0.023, 0.279, 0.040), _seen(0.060, 0.300)
+    b = SimpleNamespace(seen=[a, x], taken_since_survey=[])
+    taken_off_the_mat(b, _seen(0.0226, 0.2887, 0.048), surveyed=x)
+    assert b.taken_since_survey == [(a.x, a.y)]
+    # grasped nowhere near a sherd of the survey: the one it was taken for
+    taken_off_the_mat(b, _seen(0.20, 0.20), surveyed=x)
+    assert b.taken_since_survey[-1] == (x.x, x.y)
+    # picked up again after a drop (no sherd of the survey taken for): only if it is one
+    taken_off_the_mat(b, _seen(0.20, 0.20))
+    assert len(b.taken_since_survey) == 2

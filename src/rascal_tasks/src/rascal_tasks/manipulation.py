@@ -14,6 +14,8 @@ from rascal_tasks.wrist import route_yaw
 
 # Opening between the fingertips, from the URDF's finger limits (facts §1.4: 30..74 mm).
 MIN_OPENING, MAX_OPENING = urdf_model.opening_limits()
+# [m] how far the fingertips reach below ee_gripper_link pointing down (the URDF's finger box)
+FINGERTIP_OFFSET = urdf_model.fingertip_offset()
 # [m] fingers this much short of the opening they were sent to stopped on something: the
 # controller calls a finger within 0.5 mm of its target there (GripperMonitor::kFingerReached)
 RELEASE_SLACK = 0.002
@@ -79,6 +81,17 @@ def approach(b, o: Observation) -> None:
     )
 
 
+def regrasp_z(b, station) -> float:
+    """ee_gripper_link height that picks up again a sherd set down on `station`: the fingertips
+    perception.grasp_tip_clearance above it, as low as any grasp closes, at a fixed height as
+    the paper's stations did. Set down, a sherd lies on the station itself, at least as high
+    as the thinnest wall (3 mm, facts/sherds_and_colour.md) where the fingers close; the height
+    it showed where it was picked up says nothing of that (heap seed 36: 18-24 mm seen on the
+    heap, 6-11 mm on the pan, and the grasp there at 60 % of the first closed over it)."""
+    tip = b.config["perception"]["grasp_tip_clearance"]
+    return station.surface_z + tip + FINGERTIP_OFFSET
+
+
 def placed_observation(b, s, station) -> Observation:
     """Where the sherd in progress `s` was set down on `station`, as it was held: the blind
     grasp that picks it up again (`station_states.repick`)."""
@@ -92,7 +105,7 @@ def placed_observation(b, s, station) -> Observation:
         0.0,
         x,
         y,
-        station.surface_z + s.grasp_height,
+        regrasp_z(b, station),
         s.grasp_yaw,
         opening_for(s.width, b.config["arm"]["grasp_margin"]),
     )

@@ -13,7 +13,13 @@ from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
 from rascal_tasks.selection import covered, same_size
-from rascal_tasks.survey import SAME_SHERD, gripper_for_camera_over, lawnmower, survey_at
+from rascal_tasks.survey import (
+    SAME_SHERD,
+    gripper_for_camera_over,
+    lawnmower,
+    survey_at,
+    taken_off_the_mat,
+)
 from rascal_tasks.wrist import route_yaw
 
 
@@ -45,9 +51,9 @@ class Pickup(BatchState):
         # again (survey.account_for_slips), unless the retry took it at once
         b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
         if held or len(b.lift_slips) > slips:
-            # the survey's sherd itself left the mat (a neighbour its grasp shoves lies within
-            # the radius); one that slipped while lifted is the slip check's to look for
-            b.taken_since_survey.append((surveyed.x, surveyed.y))
+            # it left the mat (a neighbour its grasp shoves lies within the radius: not it);
+            # one that slipped while lifted is the slip check's to look for
+            taken_off_the_mat(b, o, surveyed)
         if held:
             if b.renumber is not None:  # two were put back: this one takes over that number
                 b.sherd, b.renumber = b.renumber, None

@@ -6,8 +6,7 @@ from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.selection import same_size
-from rascal_tasks.survey import SAME_SHERD, survey_at, survey_pickup_area
+from rascal_tasks.survey import survey_at, survey_pickup_area, taken_off_the_mat
 
 
 def unlikeness(c: Observation, length: float, width: float, ref) -> float:
@@ -73,14 +72,7 @@ class Recover(BatchState):
         )
         s.grasped_as(o, station)
         if station is b.pickup:
-            # the edge check (survey.account_for_vanished) asks after the last survey's own
-            # sherds: one of them was taken only if `o` is it (a look here sees afresh, and a
-            # neighbour of the spot it fell on must not count as taken)
-            b.taken_since_survey += [
-                (c.x, c.y)
-                for c in b.seen
-                if c.distance_to(o.x, o.y) <= SAME_SHERD and same_size(c, o)
-            ][:1]
+            taken_off_the_mat(b, o)  # one of the last survey's, if it is (not its neighbour)
         if station is b.pickup and s.station_index < 0:
             # Picked afresh from the pickup area: what is in the gripper now is what gets measured.
             s.seen(o, b.pickup)

@@ -7,7 +7,7 @@ from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
-from rascal_tasks.manipulation import grasp, placed_observation, release
+from rascal_tasks.manipulation import grasp, placed_observation, regrasp_z, release
 from rascal_tasks.rig import Observation
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
@@ -91,7 +91,7 @@ class Place(BatchState):
             after.make_way(s)
             return "placed"
         if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)
-            hover = st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
+            hover = regrasp_z(b, st) + b.config["arm"]["approach_offset"]
             b.move_down(*st.place_at, hover, yaw, linear=True)
         elif not plugin.release_from_above:
             b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)

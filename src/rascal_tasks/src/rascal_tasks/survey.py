@@ -142,6 +142,18 @@ def near_the_edge(area, o: Observation) -> bool:
     return min(sx / 2 - abs(o.x - cx), sy / 2 - abs(o.y - cy)) <= o.length
 
 
+def taken_off_the_mat(b, grasped: Observation, surveyed: Optional[Observation] = None):
+    """Note for the edge check which sherd of the last survey (`b.seen`) has left the mat: the
+    one the `grasped` detection (often a fresh look's) is, its nearest within SAME_SHERD (one
+    uncovered since shows more of itself, its centre shifted); else `surveyed`, the one it was
+    taken for. A fresh look may grasp a neighbour instead of the sherd it looked for, which
+    then still lies on the mat (heap seed 36: the sherd grasped was counted as still there)."""
+    near = [c for c in b.seen if c.distance_to(grasped.x, grasped.y) <= SAME_SHERD]
+    it = min(near, key=lambda c: c.distance_to(grasped.x, grasped.y), default=surveyed)
+    if it is not None:
+        b.taken_since_survey.append((it.x, it.y))
+
+
 def account_for_vanished(b, found: List[Observation]):
     """Each sherd of the survey before (`b.seen`) lying near the mat's edge that was not taken
     off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
