@@ -16,6 +16,9 @@ from rascal_tasks.wrist import route_yaw
 MIN_OPENING, MAX_OPENING = urdf_model.opening_limits()
 # [m] how far the fingertips reach below ee_gripper_link pointing down (the URDF's finger box)
 FINGERTIP_OFFSET = urdf_model.fingertip_offset()
+# [m] the thinnest sherd wall (fine ware, facts/sherds_and_colour.md): a sherd lying on a
+# station is at least this high where the fingers close
+MIN_WALL = 0.003
 # [m] fingers this much short of the opening they were sent to stopped on something: the
 # controller calls a finger within 0.5 mm of its target there (GripperMonitor::kFingerReached)
 RELEASE_SLACK = 0.002
@@ -82,12 +85,11 @@ def approach(b, o: Observation) -> None:
 
 
 def regrasp_z(b, station) -> float:
-    """ee_gripper_link height that picks up again a sherd set down on `station`: the fingertips
-    perception.grasp_tip_clearance above it, as low as any grasp closes, at a fixed height as
-    the paper's stations did. Set down, a sherd lies on the station itself, at least as high
-    as the thinnest wall (3 mm, facts/sherds_and_colour.md) where the fingers close; the height
-    it showed where it was picked up says nothing of that (heap seed 36: 18-24 mm seen on the
-    heap, 6-11 mm on the pan, and the grasp there at 60 % of the first closed over it)."""
+    """ee_gripper_link height that picks up again a sherd set down on `station` when the height
+    it was picked up at closed on nothing (grasp_where_set_down): the fingertips
+    perception.grasp_tip_clearance above it, as low as any grasp closes. Set down, a sherd lies
+    on the station itself, at least as high as the thinnest wall (3 mm,
+    facts/sherds_and_colour.md) where the fingers close."""
     tip = b.config["perception"]["grasp_tip_clearance"]
     return station.surface_z + tip + FINGERTIP_OFFSET
 
@@ -105,10 +107,30 @@ def placed_observation(b, s, station) -> Observation:
         0.0,
         x,
         y,
-        regrasp_z(b, station),
+        station.surface_z + s.grasp_height,
         s.grasp_yaw,
         opening_for(s.width, b.config["arm"]["grasp_margin"]),
     )
+
+
+def grasp_where_set_down(b, s, station) -> bool:
+    """The blind grasp that picks up again the sherd in progress `s` where it was set down on
+    `station` (placed_observation): at the height it was picked up at, so that a sherd that
+    rode on it from a heap is taken off it and the one under it, left on the pan, is weighed
+    out of the row by difference. Closing on nothing there (it lay tilted on the heap and lies
+    lower now: 18-24 mm seen there, 6-11 mm on the pan, heap seed 36), the fingers go down and
+    close again low over the station (regrasp_z), with no look between; later stations then
+    grasp it there at once. A look and a second grasp after the miss cost ~5 s a station."""
+    o = placed_observation(b, s, station)
+    if grasp(b, o, station):
+        return True
+    low = regrasp_z(b, station)
+    if low > o.grasp_z - MIN_WALL / 2:
+        return False  # as low already: a miss there is a miss
+    if not grasp(b, dataclasses.replace(o, grasp_z=low), station):
+        return False
+    s.grasp_height = low - station.surface_z
+    return True
 
 
 def reach(b, o: Observation) -> None:

@@ -7,7 +7,7 @@ from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
-from rascal_tasks.manipulation import grasp, placed_observation, regrasp_z, release
+from rascal_tasks.manipulation import grasp, grasp_where_set_down, release
 from rascal_tasks.rig import Observation
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
@@ -91,7 +91,7 @@ class Place(BatchState):
             after.make_way(s)
             return "placed"
         if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)
-            hover = regrasp_z(b, st) + b.config["arm"]["approach_offset"]
+            hover = st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
             b.move_down(*st.place_at, hover, yaw, linear=True)
         elif not plugin.release_from_above:
             b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
@@ -165,23 +165,24 @@ class Repick(BatchState):
 
 def repick(b, index) -> bool:
     """Pick the sherd in progress up again where it was set down at station `index`: blind
-    first (where it was placed, as it was held), then from a fresh look on each miss. False,
-    with the sherd recorded lost, when it could not be taken."""
+    first (where it was placed, as it was held: grasp_where_set_down), then from a fresh look
+    on each miss. False, with the sherd recorded lost, when it could not be taken."""
     s = b.sherd
     plugin = b.plugins[index]
     st = plugin.lies_at
     if plugin.hand_over() and b.rig.gripper.holding():
         return True  # picked up while the station waited (the camera's transfer)
     x, y = s.last_xy
-    o = placed_observation(b, s, st)
-    for _attempt in range(b.config["recovery"]["max_grasp_attempts"]):
-        if grasp(b, o, st):
-            return True
+    if grasp_where_set_down(b, s, st):
+        return True
+    for _attempt in range(b.config["recovery"]["max_grasp_attempts"] - 1):
         seen = survey_at(b, st, x, y)
         if not seen:
             break
         o = seen[0]
         s.grasped_as(o, st)
+        if grasp(b, o, st):
+            return True
     s.lose("could not pick it up again at %s" % st.name)
     return False
 

@@ -644,10 +644,10 @@ class ArchivalCameraStation(StationPlugin):
         b = self.batch
         if self.index + 1 < len(b.plugins) and b.next_stays(self.index) is None:
             # imported here: manipulation -> survey -> batch imports this module
-            from rascal_tasks.manipulation import grasp, placed_observation
+            from rascal_tasks.manipulation import grasp_where_set_down
 
             self.arm = ArmAt.ABOVE  # lifted, held or not: the arm is at travel height
-            if grasp(b, placed_observation(b, sherd, self.lies_at), self.lies_at):
+            if grasp_where_set_down(b, sherd, self.lies_at):
                 self.arm = ArmAt.HOLDING
 
     def _set_down_again(self, sherd):

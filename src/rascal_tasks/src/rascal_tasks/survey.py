@@ -254,13 +254,13 @@ def survey_pickup_area(b) -> List[Observation]:
     `b.leftovers`, merged the same way: a batch that ends with them there says so. A sherd the
     image border cut in every view gets a look of its own (look_at_cut_sherds)."""
     found: List[Observation] = []
-    parts: List[Leftover] = []  # what the image border cut, lying on the mat
+    parts: List[Leftover] = []  # what the image border cut, reaching onto the mat
     b.leftovers = []
 
     def look(x, y):
         merge(found, survey_at(b, b.pickup, x, y))
         new = b.rig.perception.leftovers(b.pickup.name)
-        parts.extend(lo for lo in new if lo.cut_by_border and b.pickup.area.has((lo.x, lo.y)))
+        parts.extend(lo for lo in new if lo.cut_by_border and on_the_mat(b.pickup.area, lo))
         merge(
             b.leftovers,
             [
