@@ -21,7 +21,6 @@ with open(os.path.join(PHOTOS, "photos_truth.json")) as f:
 # Also in PhotoSegmenterTest.cpp (kKnownFailures), with the same reasons.
 KNOWN_FAILURES = {
     "img129SG101853_orig.jpg": "crowded small sherds merge (118 of 119-123)",
-    "img149SG101882_orig.jpg": "a touching pair with a faint seam stays one (7 of 8-9)",
 }
 
 

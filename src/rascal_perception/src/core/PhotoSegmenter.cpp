@@ -378,12 +378,60 @@ constexpr double kSeamMinLength = 0.3;       // cut length, x sqrt(area)
 constexpr double kSeamMinContrast = 35.0;    // mean black-hat along the cut, grey levels
 constexpr double kSeamMinPart = 0.2;         // each half, x the blob's area
 constexpr double kSeamHalfSolidity = 0.93;   // each half must be this convex
+// A cut that joins two concavities (the notches where two outlines meet, one on each side of
+// the seam) is the shape of a touching pair itself, so it is looked for in blobs nearer convex
+// and with shallower notches. A blob that convex looks like one sherd, so its cut must be
+// darker: img149's camera original, a pair laid edge to edge (solidity 0.90, notches 0.06 and
+// 0.15), scores 67 grey levels; the edge of a blue band painted on a white majolica sherd, 40.
+constexpr double kPairSolidityBelow = 0.95;
+constexpr double kPairMinDefect = 0.04;      // each concavity, x sqrt(area)
+constexpr double kPairConvexContrast = 1.5;  // x kSeamMinContrast, blobs above kSeamSolidityBelow
+// The mask's closing rounds a notch, so its deepest point lies a few px beside where the seam
+// meets the outline: each end of a notch-to-notch cut is tried this many outline px around it.
+constexpr int kNotchSlack = 4;
 
 double solidity(const std::vector<cv::Point>& c) {
   std::vector<cv::Point> hull;
   cv::convexHull(c, hull);
   const double h = cv::contourArea(hull);
   return h > 0 ? cv::contourArea(c) / h : 1.0;
+}
+
+/// Concavities of an outline deeper than `min_depth` px, deepest first.
+std::vector<cv::Vec4i> concavities(const std::vector<cv::Point>& contour, double min_depth) {
+  std::vector<int> hull;
+  cv::convexHull(contour, hull, false, false);
+  std::vector<cv::Vec4i> defects;
+  if (hull.size() < 3) return defects;
+  std::sort(hull.begin(), hull.end());  // convexityDefects wants a monotonic hull
+  try {
+    cv::convexityDefects(contour, hull, defects);
+  } catch (const cv::Exception&) {  // self-intersecting contour: no concavities used
+    return {};
+  }
+  defects.erase(std::remove_if(defects.begin(), defects.end(),
+                               [&](const cv::Vec4i& d) { return d[3] / 256.0 < min_depth; }),
+                defects.end());
+  std::sort(defects.begin(), defects.end(), [](const cv::Vec4i& x, const cv::Vec4i& y) { return x[3] > y[3]; });
+  return defects;
+}
+
+/// Mean black-hat along the straight cut p-q, or -1 where the cut leaves the blob (`inside`,
+/// its mask eroded, offset by `tl`) or is too short to judge.
+double cutContrast(const cv::Point& p, const cv::Point& q, const cv::Mat& inside, const cv::Point& tl,
+                   const cv::Mat& blackhat) {
+  const int n = static_cast<int>(cv::norm(q - p));
+  double sum = 0.0;
+  int used = 0, outside = 0;
+  for (int i = 3; i <= n - 3; ++i) {  // the cut's ends lie on the edge
+    const double t = static_cast<double>(i) / n;
+    const cv::Point s(cvRound(p.x + t * (q.x - p.x)), cvRound(p.y + t * (q.y - p.y)));
+    if (!inside.at<uint8_t>(s - tl)) ++outside;
+    sum += blackhat.at<uint8_t>(s);
+    ++used;
+  }
+  if (used < 5 || outside > 0.05 * used) return -1.0;  // the cut must run through the blob
+  return sum / used;
 }
 }  // namespace
 
@@ -392,21 +440,12 @@ void PhotoSegmenter::splitAtSeams(std::vector<Blob>& blobs, const cv::Mat& rgb) 
   std::vector<Blob> out;
   for (Blob& b : blobs) {
     const double area = cv::contourArea(b.contour);
-    std::vector<int> hull;
-    cv::convexHull(b.contour, hull, false, false);
-    std::vector<cv::Vec4i> defects;
-    if (hull.size() >= 3 && solidity(b.contour) < kSeamSolidityBelow) {
-      std::sort(hull.begin(), hull.end());  // convexityDefects wants a monotonic hull
-      try {
-        cv::convexityDefects(b.contour, hull, defects);
-      } catch (const cv::Exception&) {  // self-intersecting contour: leave the blob as it is
-        defects.clear();
-      }
-    }
-    const auto deepest = std::max_element(defects.begin(), defects.end(),
-                                          [](const cv::Vec4i& x, const cv::Vec4i& y) { return x[3] < y[3]; });
     const double side = std::sqrt(area);
-    if (deepest == defects.end() || (*deepest)[3] / 256.0 < kSeamMinDefect * side) {
+    const double solid = solidity(b.contour);
+    std::vector<cv::Vec4i> notches;
+    if (solid < kPairSolidityBelow) notches = concavities(b.contour, kPairMinDefect * side);
+    const bool deep = !notches.empty() && solid < kSeamSolidityBelow && notches[0][3] / 256.0 >= kSeamMinDefect * side;
+    if (!deep && notches.size() < 2) {
       out.push_back(std::move(b));
       continue;
     }
@@ -417,33 +456,36 @@ void PhotoSegmenter::splitAtSeams(std::vector<Blob>& blobs, const cv::Mat& rgb) 
     }
     cv::Mat inside;
     cv::erode(b.mask, inside, cv::Mat::ones(3, 3, CV_8U));
-    const cv::Point p = b.contour[(*deepest)[2]];
-    double best = -1.0;
-    cv::Point best_q;
-    for (size_t k = 0; k < b.contour.size(); k += 2) {
-      const cv::Point q = b.contour[k];
-      const double length = cv::norm(q - p);
-      if (length < kSeamMinLength * side) continue;
-      const int n = static_cast<int>(length);
-      double sum = 0.0;
-      int used = 0, outside = 0;
-      for (int i = 3; i <= n - 3; ++i) {  // the cut's ends lie on the edge
-        const double t = static_cast<double>(i) / n;
-        const cv::Point s(cvRound(p.x + t * (q.x - p.x)), cvRound(p.y + t * (q.y - p.y)));
-        if (!inside.at<uint8_t>(s - b.bounds.tl())) ++outside;
-        sum += blackhat.at<uint8_t>(s);
-        ++used;
-      }
-      if (used < 5 || outside > 0.05 * used) continue;  // the cut must run through the blob
-      if (sum / used > best) {
-        best = sum / used;
+    // the darkest cut, relative to what its kind needs
+    const double pair_needs = kSeamMinContrast * (solid < kSeamSolidityBelow ? 1.0 : kPairConvexContrast);
+    double best = 0.0;
+    cv::Point best_p, best_q;
+    const auto consider = [&](const cv::Point& p, const cv::Point& q, double needs) {
+      if (cv::norm(q - p) < kSeamMinLength * side) return;
+      const double c = cutContrast(p, q, inside, b.bounds.tl(), blackhat) / needs;
+      if (c > best) {
+        best = c;
+        best_p = p;
         best_q = q;
+      }
+    };
+    if (deep) {  // from the deepest notch to wherever the outline runs darkest
+      const cv::Point p = b.contour[notches[0][2]];
+      for (size_t k = 0; k < b.contour.size(); k += 2) consider(p, b.contour[k], kSeamMinContrast);
+    }
+    const int len = static_cast<int>(b.contour.size());
+    const auto near = [&](int at, int offset) { return b.contour[((at + offset) % len + len) % len]; };
+    for (size_t i = 0; i < notches.size(); ++i) {  // from notch to notch
+      for (size_t j = i + 1; j < notches.size(); ++j) {
+        for (int di = -kNotchSlack; di <= kNotchSlack; ++di) {
+          for (int dj = -kNotchSlack; dj <= kNotchSlack; ++dj) consider(near(notches[i][2], di), near(notches[j][2], dj), pair_needs);
+        }
       }
     }
     std::vector<Blob> halves;
-    if (best >= kSeamMinContrast) {
+    if (best >= 1.0) {
       cv::Mat cut = b.mask.clone();
-      cv::line(cut, p - b.bounds.tl(), best_q - b.bounds.tl(), cv::Scalar(0), 2);
+      cv::line(cut, best_p - b.bounds.tl(), best_q - b.bounds.tl(), cv::Scalar(0), 2);
       cv::Mat labels, stats, centroids;
       const int n = cv::connectedComponentsWithStats(cut, labels, stats, centroids, 4, CV_32S);
       for (int i = 1; i < n; ++i) {
