@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -99,8 +100,8 @@ TEST(PhotoSegmenter, APairLaidEdgeToEdgeInANearlyConvexOutlineIsTwoSherds) {
 
 /// Two 80 px sherd-coloured squares on dark cloth side by side, the right one 15 px lower: one
 /// outline (solidity 0.91, no neck) with a shallow notch above and below where they meet,
-/// joined by a 2 px line `darker` grey levels below the sherd: a seam between two pieces, or a
-/// painted line on one.
+/// joined by a 2 px line `darker` grey levels below the sherd: a seam between two pieces (as
+/// dark as the cloth or darker: the gap, a shadow), or a painted line on one.
 cv::Mat steppedPair(int darker) {
   cv::Mat img(300, 400, CV_8UC3, cv::Scalar(40, 40, 45));
   const cv::Scalar sherd(200, 160, 120);
@@ -112,13 +113,44 @@ cv::Mat steppedPair(int darker) {
 
 TEST(PhotoSegmenter, ANearlyConvexOutlineIsCutOnlyAlongADarkSeamFromNotchToNotch) {
   const PhotoSegmenter segmenter{PhotoSegmenter::Options()};
-  const PhotoResult seam = segmenter.segment(steppedPair(110));
+  const PhotoResult seam = segmenter.segment(steppedPair(150));
   ASSERT_EQ(seam.sherds.size(), 2u) << "a dark seam joining the two notches splits the pair";
   EXPECT_NEAR(std::min(seam.sherds[0].blob.box.center.x, seam.sherds[1].blob.box.center.x), 160, 4);
   EXPECT_NEAR(std::max(seam.sherds[0].blob.box.center.x, seam.sherds[1].blob.box.center.x), 240, 4);
-  // a fainter line there (a painted band's edge, 40 grey levels) leaves a nearly convex sherd whole
+  // a line as dark as the black-hat asks but lighter than the cloth lies on the sherd (paint,
+  // an incised line), and a fainter one (a painted band's edge, 40 grey levels) too
+  EXPECT_EQ(segmenter.segment(steppedPair(100)).sherds.size(), 1u);
   EXPECT_EQ(segmenter.segment(steppedPair(40)).sherds.size(), 1u);
   EXPECT_EQ(segmenter.segment(steppedPair(0)).sherds.size(), 1u);
+}
+
+TEST(PhotoSegmenter, ClothLeakingIntoTheSherdsIsCutBackToThem) {
+  // img005 darkened (gamma 1.5, bench/perception_robustness): the lamp's hotspot in the middle of the dark cloth is a little
+  // lighter than the cloth's smooth estimate, weak contrast all over, and joined three sherds
+  // into one blob 21 sherds large (16 found for 18); cut back, each is found once, flagged
+  const cv::Mat rgb = photo("img005DSC02101.jpg");
+  ASSERT_FALSE(rgb.empty());
+  cv::Mat lut(1, 256, CV_8U);
+  for (int i = 0; i < 256; ++i) lut.at<uint8_t>(i) = static_cast<uint8_t>(255.0 * std::pow(i / 255.0, 1.5));  // truncated, as numpy
+  cv::Mat dark, bgr;
+  cv::LUT(rgb, lut, dark);
+  // saved as a camera would (JPEG, quality 90), as bench/perception_robustness does
+  std::vector<uint8_t> jpeg;
+  cv::cvtColor(dark, bgr, cv::COLOR_RGB2BGR);
+  cv::imencode(".jpg", bgr, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90});
+  cv::cvtColor(cv::imdecode(jpeg, cv::IMREAD_COLOR), dark, cv::COLOR_BGR2RGB);
+  const PhotoResult r = PhotoSegmenter(PhotoSegmenter::Options()).segment(dark);
+  EXPECT_EQ(r.sherds.size(), 18u);
+  int flagged = 0;
+  for (const PhotoSherd& s : r.sherds) flagged += (s.flags & kLowContrast) != 0;
+  EXPECT_GE(flagged, 3);
+  bool said = false;
+  for (const std::string& w : r.warnings) said |= w.find("cut back") != std::string::npos;
+  EXPECT_TRUE(said) << "the cut-back is said";
+  // the photo as taken: nothing leaks, nothing is cut back
+  for (const std::string& w : PhotoSegmenter(PhotoSegmenter::Options()).segment(rgb).warnings) {
+    EXPECT_EQ(w.find("cut back"), std::string::npos) << w;
+  }
 }
 
 TEST(PhotoSegmenter, CountWithinTheHandRangeOnEveryPhoto) {
