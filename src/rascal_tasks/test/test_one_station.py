@@ -248,3 +248,34 @@ def test_two_on_the_pan_keep_no_photo_and_are_not_taken_up_during_the_transfer(c
     over, down, up = world.transfer_moves[0]
     assert down[2] < over[2] and up[:2] == down[:2] and up[2] == config["arm"]["travel_z"]
     assert up[4]
+
+
+def test_a_sherd_the_take_up_missed_is_looked_for_before_it_is_grasped_again(config, monkeypatch):
+    """The camera's take-up during the transfer (REPICK's blind grasp, grasp_where_set_down)
+    closes on nothing: REPICK then looks first, instead of the same blind grasp again."""
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    scale = config.stations["scale"]
+    events = []
+    close, detect, put = fake_rig._Gripper.close, fake_rig._Perception.detect, world.put
+
+    def logged_close(gripper):
+        if world.station_at(*world.at[:2]) is scale:
+            events.append("grasp")
+        return close(gripper)
+
+    def logged_detect(perception, station):
+        if station == "scale":
+            events.append("look")
+        return detect(perception, station)
+
+    def put_and_miss(s, x, y):
+        put(s, x, y)
+        if s.station == "scale" and not events:
+            world.bad_holds[s.name] = 1  # set down: the next grasp closes on nothing
+
+    monkeypatch.setattr(fake_rig._Gripper, "close", logged_close)
+    monkeypatch.setattr(fake_rig._Perception, "detect", logged_detect)
+    world.put = put_and_miss
+    outcome, batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done"}
+    assert events[:3] == ["grasp", "look", "grasp"], events

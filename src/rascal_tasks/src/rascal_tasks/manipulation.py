@@ -129,7 +129,7 @@ def grasp_where_set_down(b, s, station) -> bool:
         return False  # as low already: a miss there is a miss
     if not grasp(b, dataclasses.replace(o, grasp_z=low), station):
         return False
-    s.grasp_height = low - station.surface_z
+    s.taken_up_at(low, station)
     return True
 
 

@@ -79,6 +79,10 @@ class SherdRecord:
         # runs, so it is not changed until that is understood: see the README's heap row)
         self.grasp_height = o.grasp_z - station.surface_z
 
+    def taken_up_at(self, z: float, station):
+        """Taken up again from `station` by fingers closed at `z`: later stations grasp it there."""
+        self.grasp_height = z - station.surface_z
+
     def placed(self, station, yaw: float):
         """Set down on `station` by a gripper turned to `yaw`: picked up again as it lies."""
         self.where, self.last_xy = station.name, tuple(station.place_at)

@@ -165,15 +165,16 @@ class Repick(BatchState):
 
 def repick(b, index) -> bool:
     """Pick the sherd in progress up again where it was set down at station `index`: blind
-    first (where it was placed, as it was held: grasp_where_set_down), then from a fresh look
-    on each miss. False, with the sherd recorded lost, when it could not be taken."""
+    first (where it was placed, as it was held: grasp_where_set_down; unless the station tried
+    that already while it waited, and missed), then from a fresh look on each miss. False,
+    with the sherd recorded lost, when it could not be taken."""
     s = b.sherd
     plugin = b.plugins[index]
     st = plugin.lies_at
     if plugin.hand_over() and b.rig.gripper.holding():
         return True  # picked up while the station waited (the camera's transfer)
     x, y = s.last_xy
-    if grasp_where_set_down(b, s, st):
+    if not plugin.missed_blind() and grasp_where_set_down(b, s, st):
         return True
     for _attempt in range(b.config["recovery"]["max_grasp_attempts"] - 1):
         seen = survey_at(b, st, x, y)

@@ -95,6 +95,12 @@ class StationPlugin:
         Asked once, by REPICK: the sherd is the next station's from then on."""
         return False
 
+    def missed_blind(self) -> bool:
+        """Whether REPICK's blind grasp was tried here while this station waited, and missed:
+        REPICK then looks before it grasps (the same two blind grasps again would miss alike).
+        Asked once, by REPICK."""
+        return False
+
     def measure_here(self, sherd, measure: Callable[[], str]) -> str:
         """For a station that `stays`: the station before measures the sherd lying here,
         `measure()` (its after_place's work, its outcome returned); this one may work around it
@@ -522,12 +528,17 @@ class ArchivalCameraStation(StationPlugin):
         self.exposure = Exposure()
         self.arm = ArmAt.ABOVE
         self._shot: Optional[Shot] = None  # of `measure_here`, for after_place
+        self._missed_blind = False  # _take_up's grasp closed on nothing (missed_blind)
 
     def hand_over(self):
         held = self.arm is ArmAt.HOLDING
         if held:
             self.arm = ArmAt.ABOVE
         return held
+
+    def missed_blind(self):
+        missed, self._missed_blind = self._missed_blind, False
+        return missed
 
     def after_place(self, sherd):
         b = self.batch
@@ -649,6 +660,8 @@ class ArchivalCameraStation(StationPlugin):
             self.arm = ArmAt.ABOVE  # lifted, held or not: the arm is at travel height
             if grasp_where_set_down(b, sherd, self.lies_at):
                 self.arm = ArmAt.HOLDING
+            else:
+                self._missed_blind = True
 
     def _set_down_again(self, sherd):
         """The sherd held up during the transfer goes back onto its spot (a retake, a failed
