@@ -10,13 +10,15 @@ from types import SimpleNamespace
 import pytest
 from fake_rig import Sherd, World, run_batch, shipped_config
 
-from rascal_tasks.rig import Observation
+from rascal_tasks.batch import PUSHED_OFF
+from rascal_tasks.rig import Leftover, Observation
 from rascal_tasks.run_batch import what_is_left
 from rascal_tasks.survey import (
     LOOK_BACK,
     MAX_EXTRA_LOOKS,
     describe_leftover,
     lawnmower,
+    look_for,
     taken_off_the_mat,
     view_over,
 )
@@ -130,3 +132,35 @@ def test_the_sherd_counted_taken_is_the_one_grasped_not_the_one_looked_for():
     # picked up again after a drop (no sherd of the survey taken for): only if it is one
     taken_off_the_mat(b, _seen(0.20, 0.20))
     assert len(b.taken_since_survey) == 2
+
+
+def _batch(leftovers=()):
+    events = []
+    b = SimpleNamespace(
+        config={"recovery": {"search_radius": 0.06}},
+        leftovers=list(leftovers),
+        not_seen_again=[],
+        event=lambda seq, kind, detail: events.append(kind),
+    )
+    return b, events
+
+
+def test_one_thing_seen_stands_for_one_sherd_not_seen_again():
+    # heap seed 36: two sherds at the far edge; a grasp flung one 10 cm off the mat and stood
+    # the other on its edge, a leftover within the search radius of where both lay
+    a, f = _seen(0.033, 0.318, 0.061), _seen(0.073, 0.331, 0.061)
+    standing = Leftover(0.018, 0.354, 0.059, 0.018, "standing on its edge?", on_edge=True)
+    b, events = _batch([standing])
+    look_for(b, PUSHED_OFF, [(o.x, o.y, o) for o in (a, f)], [], lambda c, o: True, lambda o, r: "")
+    assert [(u.x, u.y) for u in b.not_seen_again] == [(f.x, f.y)] and events == [PUSHED_OFF]
+    # a blob of a heap's sherds (longer than two of them) may stand for both
+    heap = Leftover(0.05, 0.33, 0.13, 0.08, "longer than perception.max_sherd_size")
+    b, events = _batch([heap])
+    look_for(b, PUSHED_OFF, [(o.x, o.y, o) for o in (a, f)], [], lambda c, o: True, lambda o, r: "")
+    assert b.not_seen_again == [] and events == []
+    # each seen again as a sherd of its own: nothing said
+    b, events = _batch()
+    look_for(
+        b, PUSHED_OFF, [(o.x, o.y, o) for o in (a, f)], [a, f], lambda c, o: True, lambda o, r: ""
+    )
+    assert b.not_seen_again == []

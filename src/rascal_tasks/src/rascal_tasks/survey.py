@@ -92,17 +92,24 @@ def describe_leftover(lo) -> str:
 def look_for(b, kind: str, expected, found: List[Observation], alike, say):
     """Each of `expected` ((x, y, Observation)) must be seen again by this survey: something
     `alike(c, o)` among `found` and the survey's leftovers within recovery.search_radius of
-    (x, y). Each not seen is a batch event `kind` (`say(o, radius)`: its detail) and a
-    NotSeenAgain in the batch's summary: it may lie beside the mat. One of those seen by a
-    later survey is no longer said (in a heap a sherd that fell back may lie under another
-    until that one is picked)."""
+    (x, y), each thing seen standing for one of them (the nearest first), a leftover larger
+    than several of it for any number. Each not seen is a batch event `kind` (`say(o,
+    radius)`: its detail) and a NotSeenAgain in the batch's summary: it may lie beside the mat.
+    One of those seen by a later survey is no longer said (in a heap a sherd that fell back may
+    lie under another until that one is picked).
+    (One for one: heap seed 36 at 106c498, a grasp flung one of two sherds lying at the mat's
+    far edge 10 cm off it and stood the other on its edge; the one left, a leftover within the
+    radius of both, stood for both, and the one flung off was said nowhere.)"""
     radius = b.config["recovery"]["search_radius"]
     seen = list(found) + list(b.leftovers)
 
-    def again(x, y, o):
-        return any(c.distance_to(x, y) < radius and alike(c, o) for c in seen)
+    def near(x, y, o):
+        return sorted(
+            (i for i, c in enumerate(seen) if c.distance_to(x, y) < radius and alike(c, o)),
+            key=lambda i: seen[i].distance_to(x, y),
+        )
 
-    for u in [u for u in b.not_seen_again if u.kind == kind and again(u.x, u.y, u.seen)]:
+    for u in [u for u in b.not_seen_again if u.kind == kind and near(u.x, u.y, u.seen)]:
         b.not_seen_again.remove(u)
         b.event(
             None,
@@ -110,10 +117,23 @@ def look_for(b, kind: str, expected, found: List[Observation], alike, say):
             "the sherd not seen again (%s) at (%.3f, %.3f) m is seen "
             "there now" % (kind, u.x, u.y),
         )
-    for x, y, o in expected:
-        if not again(x, y, o):
-            b.not_seen_again.append(NotSeenAgain(kind, x, y, o))
-            b.event(None, kind, say(o, radius))
+    candidates = [(x, y, o, near(x, y, o)) for x, y, o in expected]
+    used = set()
+    for x, y, o, near_it in sorted(
+        candidates, key=lambda e: seen[e[3][0]].distance_to(e[0], e[1]) if e[3] else radius
+    ):
+        free = [i for i in near_it if i not in used or _several(seen[i], o)]
+        if free:
+            used.add(free[0])
+            continue
+        b.not_seen_again.append(NotSeenAgain(kind, x, y, o))
+        b.event(None, kind, say(o, radius))
+
+
+def _several(c, o: Observation) -> bool:
+    """Whether `c`, seen, is large enough to be several sherds the size of `o` (a leftover longer
+    than perception.max_sherd_size is one blob of a heap's sherds)."""
+    return isinstance(c, Leftover) and c.length >= 2.0 * o.length
 
 
 def account_for_slips(b, found: List[Observation]):
