@@ -19,6 +19,7 @@ from rascal_tasks.survey import (
     describe_leftover,
     lawnmower,
     look_for,
+    seen_apart,
     taken_off_the_mat,
     view_over,
 )
@@ -164,3 +165,20 @@ def test_one_thing_seen_stands_for_one_sherd_not_seen_again():
         b, PUSHED_OFF, [(o.x, o.y, o) for o in (a, f)], [a, f], lambda c, o: True, lambda o, r: ""
     )
     assert b.not_seen_again == []
+
+
+def test_a_blob_of_several_sherds_seen_apart_since_is_not_asked_back_whole():
+    # heap seed 37: an "83 x 53 mm sherd" mid-mat (within its own length of the edge), the
+    # heap's sherds within half its length seen apart by the next survey, none as long
+    blob = Observation(0.162, 0.242, 0.0, 0.083, 0.053, 0.02, 0.162, 0.242, 0.01, 0.0, 0.06)
+    apart = [
+        Observation(0.1326, 0.2658, 0.0, 0.040, 0.040, 0.01, 0.13, 0.27, 0.01, 0.0, 0.05),
+        Observation(0.1826, 0.2301, 0.0, 0.056, 0.042, 0.01, 0.18, 0.23, 0.01, 0.0, 0.05),
+        Observation(0.1631, 0.2807, 0.0, 0.046, 0.032, 0.01, 0.16, 0.28, 0.01, 0.0, 0.04),
+        _seen(0.30, 0.20, 0.070),  # the heap's longest, elsewhere
+    ]
+    assert seen_apart(blob, apart)
+    # one sherd near where it lay is not the blob seen apart (one of its size may be gone)
+    assert not seen_apart(blob, apart[1:2] + apart[3:])
+    # a sherd no longer than those seen now was one sherd: asked back as it was
+    assert not seen_apart(_seen(0.162, 0.242, 0.060), apart)

@@ -18,6 +18,9 @@ from rascal_tasks.singulation import lay_flat
 CAMERA_OFFSET = urdf_model.camera_offset()
 # Two detections closer than this are the same sherd seen from two survey poses.
 SAME_SHERD = 0.02
+# Sherds seen within half a blob's length of its centre, together this much of its length x
+# width: the blob was several sherds, seen apart now (seen_apart).
+SEEN_APART = 0.75
 # Looks of their own at sherds the image border cut in every survey view (one across the mat's
 # edge): each costs a move there (about 1 s), and a batch meets a few such sherds at most.
 MAX_EXTRA_LOOKS = 3
@@ -174,6 +177,20 @@ def taken_off_the_mat(b, grasped: Observation, surveyed: Optional[Observation] =
         b.taken_since_survey.append((it.x, it.y))
 
 
+def seen_apart(o: Observation, found: List[Observation]) -> bool:
+    """Whether `o`, of an earlier survey, was several of a heap's sherds seen as one that this
+    survey (`found`) sees apart: longer than any sherd it sees, and two or more sherds lie
+    within half its length of its centre, together at least SEEN_APART of its size (heap seed
+    37: an "83 x 53 mm sherd" mid-mat, longer than the heap's largest, 70 mm, was asked back
+    whole and said pushed off the mat)."""
+    if not found or o.length <= max(c.length for c in found):
+        return False
+    pieces = [c for c in found if c.distance_to(o.x, o.y) < o.length / 2]
+    return len(pieces) >= 2 and sum(c.length * c.width for c in pieces) >= (
+        SEEN_APART * o.length * o.width
+    )
+
+
 def account_for_vanished(b, found: List[Observation]):
     """Each sherd of the survey before (`b.seen`) lying near the mat's edge that was not taken
     off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
@@ -189,6 +206,7 @@ def account_for_vanished(b, found: List[Observation]):
         if near_the_edge(b.pickup.area, o)  # elsewhere: moved, or under another, still on the mat
         # taken itself (a neighbour taken beside it does not count)
         and all(math.hypot(o.x - x, o.y - y) > SAME_SHERD for x, y in b.taken_since_survey)
+        and not seen_apart(o, found)
     ]
     look_for(
         b,
