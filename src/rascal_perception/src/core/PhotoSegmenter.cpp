@@ -417,16 +417,24 @@ std::vector<cv::Vec4i> concavities(const std::vector<cv::Point>& contour, double
   return defects;
 }
 
+/// The pixels of the straight cut p-q, one per px, less 3 at each end (they lie on the edge).
+std::vector<cv::Point> pointsAlongCut(const cv::Point& p, const cv::Point& q) {
+  const int n = static_cast<int>(cv::norm(q - p));
+  std::vector<cv::Point> points;
+  for (int i = 3; i <= n - 3; ++i) {
+    const double t = static_cast<double>(i) / n;
+    points.emplace_back(cvRound(p.x + t * (q.x - p.x)), cvRound(p.y + t * (q.y - p.y)));
+  }
+  return points;
+}
+
 /// Mean black-hat along the straight cut p-q, or -1 where the cut leaves the blob (`inside`,
 /// its mask eroded, offset by `tl`) or is too short to judge.
 double cutContrast(const cv::Point& p, const cv::Point& q, const cv::Mat& inside, const cv::Point& tl,
                    const cv::Mat& blackhat) {
-  const int n = static_cast<int>(cv::norm(q - p));
   double sum = 0.0;
   int used = 0, outside = 0;
-  for (int i = 3; i <= n - 3; ++i) {  // the cut's ends lie on the edge
-    const double t = static_cast<double>(i) / n;
-    const cv::Point s(cvRound(p.x + t * (q.x - p.x)), cvRound(p.y + t * (q.y - p.y)));
+  for (const cv::Point& s : pointsAlongCut(p, q)) {
     if (!inside.at<uint8_t>(s - tl)) ++outside;
     sum += blackhat.at<uint8_t>(s);
     ++used;
@@ -457,12 +465,8 @@ double medianGrey(const cv::Mat& grey, const cv::Mat& mask) {
 /// notch-to-notch cuts' false seams on the photos' held-out transforms) lie on the sherd and
 /// are lighter: 0.14-0.80 of the way; the pairs laid edge to edge, at most the cloth's grey.
 bool showsTheCloth(const cv::Mat& grey, const Blob& b, const cv::Point& p, const cv::Point& q) {
-  const int n = static_cast<int>(cv::norm(q - p));
   std::vector<uint8_t> along;
-  for (int i = 3; i <= n - 3; ++i) {
-    const double t = static_cast<double>(i) / n;
-    along.push_back(grey.at<uint8_t>(cv::Point(cvRound(p.x + t * (q.x - p.x)), cvRound(p.y + t * (q.y - p.y)))));
-  }
+  for (const cv::Point& s : pointsAlongCut(p, q)) along.push_back(grey.at<uint8_t>(s));
   if (along.empty()) return false;
   std::nth_element(along.begin(), along.begin() + along.size() / 2, along.end());
   constexpr int kRing = 5;  // px around the blob: the cloth beside it
@@ -594,6 +598,14 @@ void removeFrame(cv::Mat& fg, PhotoResult& r) {
 }  // namespace
 
 namespace {
+/// Closes pinholes and paint cracks (radius px), then opens away lint and scratches (twice that).
+void cleanMask(cv::Mat& mask, int radius) {
+  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(4 * radius + 1, 4 * radius + 1)));
+}
+
 /// Where the cloth's estimate misses a hotspot or a gradient (a lamp on a dark cloth), the
 /// cloth there is a little lighter than the estimate: weak contrast all over, which the
 /// hysteresis joins to the sherds lying in it, one blob many sherds large and mostly weak.
@@ -603,10 +615,7 @@ namespace {
 std::vector<Blob> cutBackToStrong(const Blob& b, const cv::Mat& strong, const SegmentationOptions& o, int radius) {
   cv::Mat part = cv::Mat::zeros(strong.size(), CV_8U);
   part(b.bounds).setTo(255, strong(b.bounds) & b.mask);
-  cv::morphologyEx(part, part, cv::MORPH_CLOSE,
-                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
-  cv::morphologyEx(part, part, cv::MORPH_OPEN,
-                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(4 * radius + 1, 4 * radius + 1)));
+  cleanMask(part, radius);
   return SherdSegmenter().blobs(part, o);
 }
 }  // namespace
@@ -665,11 +674,7 @@ PhotoResult PhotoSegmenter::segment(const cv::Mat& rgb, const cv::Mat& backgroun
   }
   const double min_side = options_.min_side_mm * px_per_mm;
   const int radius = std::max(1, cvRound(options_.clean_radius_mm * px_per_mm));
-  // close pinholes and paint cracks, then open away lint and scratches
-  cv::morphologyEx(fg, fg, cv::MORPH_CLOSE,
-                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
-  cv::morphologyEx(fg, fg, cv::MORPH_OPEN,
-                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(4 * radius + 1, 4 * radius + 1)));
+  cleanMask(fg, radius);
   removeFrame(fg, r);
   const double cell = longer / kCoarseCells;
   // on the floor, a chair, a bag beside the cloth, or a sliver along its edge (the outline is
