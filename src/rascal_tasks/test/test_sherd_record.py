@@ -1,6 +1,7 @@
 """Core tests of SherdRecord: a sherd's catalogue writes and the one path that ends it (done or
 lost), which is where completed and lost sherds are counted (no master, no database)."""
 
+import math
 import os
 
 import pytest
@@ -121,3 +122,23 @@ def test_an_unstable_reading_is_never_a_mass(config):
     assert (s.status, s.mass) == ("mass_unstable", None)
     s.record_mass(0.0139)  # weighed again, settled
     assert (row.status, row.mass, row.mass_missing_reason) == ("weighed", 0.0139, None)
+
+
+def test_a_grasp_turned_off_the_minor_axis_on_the_mat_is_turned_back_at_the_station(config):
+    # On the mat neighbours made perception turn the grasp 30 degrees off the sherd's minor axis
+    # (yaw 0.2: its major axis; grasp yaw 0.2 + 30 deg); set down at the scale by a gripper at
+    # yaw 1.0, the sherd's minor axis lies at 1.0 - 30 deg: it is taken up again across it.
+    b, _ = _batch(config)
+    turn = math.pi / 6
+    turned = Observation(0.1, 0.2, 0.2, 0.06, 0.03, 0.01, 0.1, 0.2, 0.005, 0.2 + turn, 0.06)
+    s = SherdRecord.picked(b, turned, b.pickup, attempts=1)
+    s.placed(config.stations["scale"], 1.0)
+    assert math.isclose(s.grasp_yaw, 1.0 - turn)
+    # held so, and set down again at another yaw: it is not turned a second time
+    s.placed(config.stations["camera"], 1.5)
+    assert math.isclose(s.grasp_yaw, 1.5)
+    # a grasp across the minor axis (the fingers alike: yaw and yaw + pi) stays as it was held
+    across = Observation(0.1, 0.2, 0.0, 0.05, 0.04, 0.01, 0.1, 0.2, 0.005, math.pi, 0.052)
+    s = SherdRecord.picked(b, across, b.pickup, attempts=1)
+    s.placed(config.stations["scale"], 2.5)
+    assert math.isclose(s.grasp_yaw, 2.5)

@@ -2,6 +2,8 @@
 from the config's stations, and a new station type is a class plus a config entry."""
 
 import copy
+import dataclasses
+import math
 import os
 
 import pytest
@@ -345,6 +347,17 @@ def test_sherds_nothing_lies_on_are_picked_first_whatever_the_policy():
     b.grasp_clear = False
     for policy in ("nearest", "largest", "most_isolated"):
         assert in_pick_order([a, b, c, d], policy) == [c, b, d, a], policy
+
+
+def test_of_free_sherds_one_whose_grasp_is_turned_off_its_minor_axis_goes_after_the_others():
+    # a (nearest) has a neighbour by its minor axis: perception turned its grasp 45 degrees
+    a = dataclasses.replace(_obs(0.10, 0.20, 0.060, 0.030), yaw=0.3, grasp_yaw=0.3 + math.pi / 4)
+    b = dataclasses.replace(_obs(0.20, 0.20, 0.050, 0.030), yaw=0.3, grasp_yaw=0.3 + math.pi)
+    c = dataclasses.replace(_obs(0.30, 0.30, 0.040, 0.030), yaw=-1.2, grasp_yaw=-1.2 + 0.2)
+    assert in_pick_order([a, b, c], "nearest") == [b, c, a]
+    # one whose fingers would land on a neighbour still goes after it
+    b.grasp_clear = False
+    assert in_pick_order([a, b, c], "nearest") == [c, a, b]
 
 
 def test_a_covered_sherd_is_never_taken_from_an_old_survey(data):

@@ -107,6 +107,19 @@ class Simulator {
   bool triggerCapture(std::string& why, double exposure_ev = 0.0);
   static constexpr double kMaxExposureEv = 3.0;
 
+  /// The last grasp the fingers made and how likely it was to slip (simulator's model): for the
+  /// node's log, so a run's drops can be traced to their grasps. `count` grows by one a grasp.
+  struct GraspRecord {
+    int count = 0;
+    int sherd = -1;
+    double time = 0.0;
+    double off_centre = 0.0;  ///< of half the sherd's length, 0..1
+    double along = 0.0;       ///< |cos| of the closing direction to the outline's major axis
+    double elongation = 0.0;  ///< 1 - width / length of the outline
+    double slip_chance = 0.0;
+  };
+  const GraspRecord& lastGrasp() const { return last_grasp_; }
+
   bool injectFault(int fault, double duration, std::string& message);
   std::vector<SherdState> groundTruth() const;
   World& world() { return *world_; }
@@ -147,6 +160,7 @@ class Simulator {
   bool open_requested_ = false;  // an open was commanded: the held sherd goes
   bool slip_armed_ = false;
   double slip_delay_ = 0.0, slip_lifted_since_ = -1.0;
+  GraspRecord last_grasp_;
   RenderOutput scratch_;
   std::vector<RenderItem> items_;
 };

@@ -9,6 +9,7 @@
 #include <malloc.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -109,6 +110,7 @@ void SimNode::run() {
     sim0 = sim_->time();
   }
   const auto& names = ArmKinematics::jointNames();
+  int grasps_logged = 0;
   while (ros::ok()) {
     double t = 0.0;
     bool clock = false, joints = false, scale = false, frame_ready = false;
@@ -140,6 +142,16 @@ void SimNode::run() {
         js.velocity.push_back(-sim_->fingerVelocity());
       }
       scale = sim_->takeScaleReading(reading);
+      const Simulator::GraspRecord& g = sim_->lastGrasp();
+      if (g.count != grasps_logged) {
+        grasps_logged = g.count;
+        // the model's slip chance of each grasp, so a run's drops can be traced to their grasps
+        ROS_INFO("sim: grasp of %s at t=%.2f s: %.2f of half its length off its centre, "
+                 "closing %.2f along its long axis (elongation %.2f): slip chance %.3f",
+                 sim_->world().sherd(g.sherd).name.c_str(), g.time, g.off_centre, g.along,
+                 g.elongation, g.slip_chance);
+        std::fflush(stdout);  // a log file is block-buffered: a bench reads it while this runs
+      }
       if (sim_->wristFrameDue()) {
         if (cameraWanted()) {
           frame = sim_->renderWristFrame();

@@ -11,6 +11,11 @@ from rascal_tasks.rig import Observation
 # a free one is left: lifting it would drag or lift the one on top (a tipped-out bag). Its
 # measurement is of the part that shows; it is picked from a later survey, once uncovered.
 COVERED = 0.05
+# A grasp turned further than this off closing across the sherd's minor axis (perception turns
+# it where a neighbour blocks a finger) closes on a longer chord nearer the narrow ends, and
+# slips more: such a sherd is taken after the others of its kind, by when its neighbours may be
+# gone (perception's candidates: 0, 15, 30, 45 and 90 degrees).
+TURNED = math.radians(20.0)
 # Two measurements of one sherd agree this well in length and width (one that fell may lie
 # tilted now).
 SAME_SIZE = 0.25
@@ -27,10 +32,16 @@ def covered(o: Observation) -> bool:
     return o.covered > COVERED
 
 
+def turned(o: Observation) -> bool:
+    """Whether its grasp is turned off its minor axis (TURNED)."""
+    return abs(math.remainder(o.grasp_yaw - o.yaw, math.pi)) > TURNED
+
+
 def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
     """`found` in the order to pick it: sherds nothing lies on first (the top of a heap), the
     least covered of the rest after them; of alike covered ones, those whose fingers clear the
-    neighbours (perception's grasp_clear) first; then by `policy`:
+    neighbours (perception's grasp_clear) first, and of those the ones whose grasp closes across
+    their minor axis (not `turned`); then by `policy`:
     - nearest: nearest the arm's base first (the shortest reach, the least time; the default);
     - largest: largest length x width first;
     - most_isolated: largest edge-to-edge gap to its nearest neighbour first.
@@ -48,4 +59,6 @@ def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
         ordered = sorted(found, key=lambda o: -gap(o))
     else:
         ordered = sorted(found, key=lambda o: math.hypot(o.x, o.y))
-    return sorted(ordered, key=lambda o: (o.covered if covered(o) else 0.0, not o.grasp_clear))
+    return sorted(
+        ordered, key=lambda o: (o.covered if covered(o) else 0.0, not o.grasp_clear, turned(o))
+    )

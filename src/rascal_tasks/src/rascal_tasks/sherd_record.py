@@ -8,9 +8,11 @@ recorded, the row says why). `done` and `lost` both end in `_finish`, the one pl
 completed and lost sherds. No ROS here.
 """
 
+import math
 from typing import Optional, Tuple
 
 from rascal_tasks.rig import Observation, Timings
+from rascal_tasks.wrist import wrist_angle
 
 FINAL = ("done", "lost")
 
@@ -22,6 +24,9 @@ class SherdRecord:
         self.status = status  # catalogue status, as far as this run knows
         self.observation: Optional[Observation] = None  # its detection (for its likeness)
         self.grasp_yaw = 0.0
+        # how far the grasp is turned off closing across its minor axis (rad, within +-pi/2):
+        # perception turns it where neighbours block the fingers (a heap)
+        self.turn = 0.0
         self.grasp_height = 0.0  # ee height above the surface when closing
         self.width = 0.0  # across the fingers (m): seen from above, or as they last held it
         self.station_index = -1  # last station done (-1: none yet)
@@ -74,6 +79,7 @@ class SherdRecord:
     def grasped_as(self, o: Observation, station):
         """The next grasp follows the detection `o` on `station`."""
         self.grasp_yaw, self.width = o.grasp_yaw, o.width
+        self.turn = math.remainder(o.grasp_yaw - o.yaw, math.pi)
         # (above the station's surface: for a sherd taken from the top of a heap this includes
         # what it lay on; handling it above its own support instead gave more drops in two heap
         # runs, so it is not changed until that is understood: see the README's heap row)
@@ -84,9 +90,19 @@ class SherdRecord:
         self.grasp_height = z - station.surface_z
 
     def placed(self, station, yaw: float):
-        """Set down on `station` by a gripper turned to `yaw`: picked up again as it lies."""
+        """Set down on `station` by a gripper turned to `yaw`: picked up again as it lies, across
+        its minor axis. A grasp turned off that axis (neighbours in the way on the mat) closes on
+        a longer chord nearer its narrow ends, and slips more; on the station nothing is in the
+        way, so the next grasp is turned back (heap seed 36: half the model's slip chance of the
+        batch was in such grasps, repeated at each station)."""
         self.where, self.last_xy = station.name, tuple(station.place_at)
-        self.grasp_yaw = yaw
+        x, y = self.last_xy
+        back = (yaw - self.turn, yaw - self.turn + math.pi)  # the fingers are alike
+        self.grasp_yaw = math.remainder(
+            min(back, key=lambda g: abs(wrist_angle(x, y, g) - wrist_angle(x, y, yaw))),
+            2.0 * math.pi,
+        )
+        self.turn = 0.0
 
     def station_done(self, index: int):
         self.station_index = index
