@@ -155,6 +155,14 @@ TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
   const auto truth = sim.groundTruth()[0];
   EXPECT_TRUE(truth.held);
   EXPECT_GT(truth.pose.translation().z(), 0.03);
+  // the grasp is on record for the node's log: centred, across the minor axis, the model's base
+  const Simulator::GraspRecord& g = sim.lastGrasp();
+  EXPECT_EQ(g.count, 1);
+  EXPECT_EQ(g.sherd, truth.name);
+  EXPECT_LT(g.off_centre, 0.1);
+  EXPECT_LT(g.along, 0.1);
+  EXPECT_NEAR(g.slip_chance, 0.02, 0.01);
+  EXPECT_NE(g.describe().find("grasp of " + truth.name), std::string::npos);
   // stopping the fingers where they are (a stop, or a command to their position) is no open
   sim.stopGripper();
   sim.commandGripper(sim.fingerPosition());

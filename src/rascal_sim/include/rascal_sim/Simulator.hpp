@@ -111,12 +111,14 @@ class Simulator {
   /// node's log, so a run's drops can be traced to their grasps. `count` grows by one a grasp.
   struct GraspRecord {
     int count = 0;
-    int sherd = -1;
+    std::string sherd;  ///< its name
     double time = 0.0;
     double off_centre = 0.0;  ///< of half the sherd's length, 0..1
     double along = 0.0;       ///< |cos| of the closing direction to the outline's major axis
     double elongation = 0.0;  ///< 1 - width / length of the outline
     double slip_chance = 0.0;
+    /// One line for a log: "grasp of sherd_04 at t=101.29 s: ... slip chance 0.352".
+    std::string describe() const;
   };
   const GraspRecord& lastGrasp() const { return last_grasp_; }
 

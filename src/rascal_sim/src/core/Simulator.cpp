@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -193,12 +194,21 @@ void Simulator::updateGrasp() {
   double p = 0.02 + 0.5 * off * off + 0.6 * along * along * std::clamp(2.5 * elongation, 0.0, 1.0);
   if (s.mass > kMaxPayload) p += 0.9;
   p = std::min(0.98, p);
-  last_grasp_ = {last_grasp_.count + 1, i, time(), off, along, elongation, p};
+  last_grasp_ = {last_grasp_.count + 1, s.name, time(), off, along, elongation, p};
   const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng_);
   slip_armed_ = drop_next_grasp_ || u < p;
   drop_next_grasp_ = false;
   slip_delay_ = std::uniform_real_distribution<double>(0.05, 0.6)(rng_);
   slip_lifted_since_ = -1.0;
+}
+
+std::string Simulator::GraspRecord::describe() const {
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "grasp of %s at t=%.2f s: %.2f of half its length off its centre, closing %.2f "
+                "along its long axis (elongation %.2f): slip chance %.3f",
+                sherd.c_str(), time, off_centre, along, elongation, slip_chance);
+  return line;
 }
 
 bool Simulator::takeScaleReading(ScaleReading& reading) {

@@ -142,15 +142,10 @@ void SimNode::run() {
         js.velocity.push_back(-sim_->fingerVelocity());
       }
       scale = sim_->takeScaleReading(reading);
-      const Simulator::GraspRecord& g = sim_->lastGrasp();
-      if (g.count != grasps_logged) {
-        grasps_logged = g.count;
-        // the model's slip chance of each grasp, so a run's drops can be traced to their grasps
-        ROS_INFO("sim: grasp of %s at t=%.2f s: %.2f of half its length off its centre, "
-                 "closing %.2f along its long axis (elongation %.2f): slip chance %.3f",
-                 sim_->world().sherd(g.sherd).name.c_str(), g.time, g.off_centre, g.along,
-                 g.elongation, g.slip_chance);
-        std::fflush(stdout);  // a log file is block-buffered: a bench reads it while this runs
+      if (sim_->lastGrasp().count != grasps_logged) {  // each grasp's slip chance, for benches
+        grasps_logged = sim_->lastGrasp().count;
+        ROS_INFO_STREAM("sim: " << sim_->lastGrasp().describe());
+        std::fflush(stdout);  // block-buffered into a file: a bench reads it while this runs
       }
       if (sim_->wristFrameDue()) {
         if (cameraWanted()) {
