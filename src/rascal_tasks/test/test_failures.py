@@ -16,6 +16,7 @@ from rascal_tasks.batch import PUSHED_OFF, SLIPPED_AWAY
 from rascal_tasks.catalogue.errors import CatalogueError
 from rascal_tasks.config import config_from_dict
 from rascal_tasks.failures import LOSE_SHERD, STOP, SherdFailure, classify
+from rascal_tasks.pickup import miss_spot
 from rascal_tasks.rig import Leftover, Observation, RigError
 from rascal_tasks.run_batch import what_is_left
 from rascal_tasks.singulation import topple_direction, was_pushed
@@ -137,6 +138,22 @@ def test_a_sherd_dropped_back_on_the_mat_and_not_grasped_there_gives_its_number_
     assert batch.lost == 0
     assert {s.station for s in world.sherds} == {"discard"}
     assert any("goes to the next sherd picked" in n for n in rec.sherds[1].notes)
+
+
+def test_misses_on_a_sherd_nudged_across_a_grid_line_count_at_one_spot():
+    # heap seed 39: the fingers nudged a sherd lying across another by a fraction of a
+    # millimetre between rounds; rounded to 1 cm it was at (0.08, 0.20), then (0.09, 0.20), and
+    # each round started again at no misses (nine grasps, three rounds, before the push)
+    b = SimpleNamespace(misses={})
+    first = miss_spot(b, _at(0.08499, 0.1987))
+    b.misses[first] = 1
+    assert miss_spot(b, _at(0.08501, 0.1988)) == first == (0.08, 0.2)
+    # a sherd a centimetre and more away is a spot of its own
+    assert miss_spot(b, _at(0.0951, 0.1987)) == (0.1, 0.2)
+
+
+def _at(x, y):
+    return Observation(x, y, 0.0, 0.05, 0.035, 0.01, x, y, 0.005, 0.0, 0.047)
 
 
 def test_an_unreachable_sherd_in_the_pickup_area_is_left_unnumbered(config):
