@@ -123,9 +123,9 @@ def miss_spot(b, o: Observation) -> Tuple[float, float]:
     earlier miss's within SAME_SPOT, else its own. By the grid alone a sherd nudged across a
     grid line (0.0849 -> 0.0851 m) started again at no misses: heap seed 39 missed nine grasps,
     three rounds, on a sherd lying across another before the push after two rounds."""
-    near = [k for k in b.misses if math.hypot(k[0] - o.x, k[1] - o.y) < SAME_SPOT]
-    if near:
-        return min(near, key=lambda k: math.hypot(k[0] - o.x, k[1] - o.y))
+    nearest = min(b.misses, key=lambda k: o.distance_to(*k), default=None)
+    if nearest is not None and o.distance_to(*nearest) < SAME_SPOT:
+        return nearest
     return (round(o.x, 2), round(o.y, 2))
 
 

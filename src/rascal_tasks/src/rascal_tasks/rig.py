@@ -45,6 +45,12 @@ class Observation:
     support: float = 0.0  # top of what it lies on above the station surface (a sherd in a heap)
 
     @property
+    def grasp_turn(self) -> float:
+        """How far its grasp is turned off closing across its minor axis (rad, within +-pi/2):
+        perception turns it where a neighbour blocks a finger (a heap)."""
+        return math.remainder(self.grasp_yaw - self.yaw, math.pi)
+
+    @property
     def own_height(self) -> float:
         """Its height as it lies, from what it rests on (in a heap: not the sherd under it)."""
         return max(self.height - self.support, 0.0)

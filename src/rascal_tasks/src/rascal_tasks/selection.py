@@ -34,7 +34,7 @@ def covered(o: Observation) -> bool:
 
 def turned(o: Observation) -> bool:
     """Whether its grasp is turned off its minor axis (TURNED)."""
-    return abs(math.remainder(o.grasp_yaw - o.yaw, math.pi)) > TURNED
+    return abs(o.grasp_turn) > TURNED
 
 
 def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:

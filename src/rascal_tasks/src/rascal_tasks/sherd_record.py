@@ -24,9 +24,7 @@ class SherdRecord:
         self.status = status  # catalogue status, as far as this run knows
         self.observation: Optional[Observation] = None  # its detection (for its likeness)
         self.grasp_yaw = 0.0
-        # how far the grasp is turned off closing across its minor axis (rad, within +-pi/2):
-        # perception turns it where neighbours block the fingers (a heap)
-        self.turn = 0.0
+        self.turn = 0.0  # of the next grasp (Observation.grasp_turn)
         self.grasp_height = 0.0  # ee height above the surface when closing
         self.width = 0.0  # across the fingers (m): seen from above, or as they last held it
         self.station_index = -1  # last station done (-1: none yet)
@@ -79,7 +77,7 @@ class SherdRecord:
     def grasped_as(self, o: Observation, station):
         """The next grasp follows the detection `o` on `station`."""
         self.grasp_yaw, self.width = o.grasp_yaw, o.width
-        self.turn = math.remainder(o.grasp_yaw - o.yaw, math.pi)
+        self.turn = o.grasp_turn
         # (above the station's surface: for a sherd taken from the top of a heap this includes
         # what it lay on; handling it above its own support instead gave more drops in two heap
         # runs, so it is not changed until that is understood: see the README's heap row)
