@@ -445,6 +445,41 @@ def test_two_put_back_together_that_stay_one_on_the_other_are_taken_apart(config
     assert all(s.station == "discard" for s in world.sherds)
 
 
+def test_one_of_two_that_falls_back_onto_the_scale_on_the_way_is_fetched_too(config, monkeypatch):
+    # the put back's grasp takes one of the pair off the pan, and it slips out on the way to
+    # the mat, back onto the pan: both still lie there. Each is fetched and set down apart,
+    # nothing is said to lie where nothing was let go, and the next sherd's tare finds the pan
+    # empty (not "weighed tared over" a sherd that then goes to the discard box unrecorded)
+    import rascal_tasks.station_states as station_states
+
+    world = World(
+        config,
+        [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.29), Sherd("c", 0.20, 0.21, mass=0.015)],
+    )
+    world.doubles = {"a": "b"}
+    real_repick, fired = station_states.repick, []
+
+    def slipping(b, index):  # the first repick is the put back's (the pair is weighed first)
+        held = real_repick(b, index)
+        if held and not fired:  # it falls back where it was taken from
+            fired.append(world.held.name)
+            world.slips[world.held.name] = config.stations["scale"].place_at
+        return held
+
+    monkeypatch.setattr(station_states, "repick", slipping)
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished"
+    assert recorder.status() == {1: "done", 2: "done", 3: "done"}
+    masses = sorted(round(r.mass, 4) for r in recorder.sherds.values())
+    assert masses == [0.015, 0.02, 0.02]  # never 40 g in one row, none weighed over another
+    notes = [n for r in recorder.sherds.values() for n in r.notes]
+    assert not any(n.startswith("pan_loaded") for n in notes), notes
+    (put_back,) = [n for n in notes if n.startswith("put_back: ")]
+    assert len(re.findall(r"\(([-\d.]+), ([-\d.]+)\) m", put_back)) == 2, put_back
+    assert any(n.startswith("dropped: putting two sherds") for n in notes), notes
+    assert all(s.station == "discard" for s in world.sherds)
+
+
 def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(config, monkeypatch):
     # taken from the top of a heap (lying 20 mm up on another), set down on the scale it lies
     # on the pan: the blind grasp at the height it was picked up at closes over it; the fingers

@@ -196,6 +196,7 @@ class PutBack(BatchState):
     gap and no row of two."""
 
     next_sherd = "lost"
+    AT_MOST = 3  # fetches of what stays on the scale: the two sherds, and one more try
 
     def __init__(self, batch, index):
         super().__init__(batch, ["surveyed", "lost"])
@@ -210,40 +211,51 @@ class PutBack(BatchState):
         st = b.plugins[self.index].lies_at
         if not repick(b, self.index):
             return "lost"  # recorded lost (the two lie at the station, for a person)
-        spots = [free_spot(b.pickup.area, b.seen)]
-        self._set_down(*spots[0])
+        first = free_spot(b.pickup.area, b.seen)
+        spots = [first] if self._set_down(*first) else []
+        if not spots:
+            # what the grasp took fell on the way (back onto the station, or where a later
+            # survey finds it): the station is looked at again below, like one it left there
+            s.dropped("putting two sherds lifted as one back on the pickup mat")
         plugin = b.plugins[self.index]
-        if isinstance(plugin, ScaleStation) and plugin.holds_something():
-            # the grasp took one of the two: the other is fetched too, and set down apart
-            spot = clear_to_mat(b, st, self._spot_beside(spots[0]))
-            if spot is None:
-                raise SherdFailure(
-                    "the second of two sherds lifted as one stays on the %s" % st.name, st
-                )
-            spots.append(spot)
-        else:
+        if isinstance(plugin, ScaleStation):
+            # the grasp took one of the two, or the carry dropped it back: what the pan still
+            # holds is fetched too, each set down apart (the two, and one more try)
+            for _ in range(self.AT_MOST):
+                if not plugin.holds_something():
+                    break
+                spot = clear_to_mat(b, st, self._spot_beside(spots))
+                if spot is not None:
+                    spots.append(spot)
+            else:
+                if plugin.holds_something():
+                    raise SherdFailure(
+                        "the second of two sherds lifted as one stays on the %s" % st.name, st
+                    )
+        if spots == [first]:
             # both came in the one grasp and were set down together: if one still lies on the
             # other, the top one is taken apart (set down together they may not fall apart,
             # and the next grasp would take the two again)
             top = self._lying_on_another(*spots[0])
             if top is not None and grasp(b, top, b.pickup):
                 taken_off_the_mat(b, top)  # set down elsewhere: not asked back where it lay
-                spots.append(self._spot_beside(spots[0]))
-                self._set_down(*spots[1], top)
-        text = (
-            "two sherds in one grasp: put back apart at %s; this number goes to the next "
-            "sherd picked" % ", ".join("(%.3f, %.3f) m" % p for p in spots)
+                spot = self._spot_beside(spots)
+                if self._set_down(*spot, top):
+                    spots.append(spot)
+        where = ", ".join("(%.3f, %.3f) m" % p for p in spots)
+        text = "two sherds in one grasp: %s; this number goes to the next sherd picked" % (
+            "put back apart at %s" % where if spots else "they fell on the way back to the mat"
         )
         b.event(s, "put_back", text)
         s.note(text)
         b.number_to_next_pick(s, "put back on the pickup mat as two sherds and not seen again")
         return "surveyed"
 
-    def _spot_beside(self, first):
-        """The freest spot of the pickup mat once something lies at `first` too."""
+    def _spot_beside(self, taken):
+        """The freest spot of the pickup mat once something lies at each of `taken` too."""
         b = self.batch
-        here = Observation(*first, 0.0, 0.1, 0.1, 0.0, *first, 0.0, 0.0, 0.0)
-        return free_spot(b.pickup.area, b.seen + [here])
+        here = [Observation(*xy, 0.0, 0.1, 0.1, 0.0, *xy, 0.0, 0.0, 0.0) for xy in taken]
+        return free_spot(b.pickup.area, b.seen + here)
 
     def _lying_on_another(self, x, y):
         """The sherd near (x, y) of the pickup mat that lies on another one, or None."""
@@ -256,27 +268,33 @@ class PutBack(BatchState):
         on_top = [c for c in near if c.support > STACKED]
         return max(on_top, key=lambda c: c.height) if on_top else None
 
-    def _set_down(self, x, y, held=None):
+    def _set_down(self, x, y, held=None) -> bool:
         """Carry what is in the fingers to (x, y) of the pickup mat and let it go just above;
-        `held`: the Observation it was grasped as (default: the sherd in progress)."""
+        `held`: the Observation it was grasped as (default: the sherd in progress). False when
+        the fingers came there empty."""
         b = self.batch
         s = b.sherd
         if held is None:
-            set_down_on_mat(b, x, y, s.grasp_yaw, s.grasp_height, s.width)
-        else:
-            height = held.grasp_z - b.pickup.surface_z
-            set_down_on_mat(b, x, y, held.grasp_yaw, height, held.width)
+            return set_down_on_mat(b, x, y, s.grasp_yaw, s.grasp_height, s.width)
+        height = held.grasp_z - b.pickup.surface_z
+        return set_down_on_mat(b, x, y, held.grasp_yaw, height, held.width)
 
 
-def set_down_on_mat(b, x, y, yaw, height, width):
+def set_down_on_mat(b, x, y, yaw, height, width) -> bool:
     """Carry what is in the fingers (held `height` above what it lies on, `width` wide) to
-    (x, y) of the pickup mat and let it go just above."""
+    (x, y) of the pickup mat and let it go just above. False, with the fingers opened above,
+    when they came there empty: it fell on the way, and lies where it fell, not at (x, y)."""
     b.move_down(x, y, b.travel_z(), yaw)
+    if not b.rig.gripper.holding():
+        with b.phase("grasping"):
+            release(b, width)
+        return False
     low = b.pickup.surface_z + height + b.config["arm"]["place_clearance"]
     b.move_down(x, y, low, yaw, linear=True)
     with b.phase("grasping"):
         release(b, width)
     b.move_down(x, y, b.travel_z(), yaw, linear=True)
+    return True
 
 
 def clear_to_mat(b, st, spot=None) -> Optional[Tuple[float, float]]:
@@ -294,8 +312,9 @@ def clear_to_mat(b, st, spot=None) -> Optional[Tuple[float, float]]:
     except SherdFailure:
         return None  # its grasp was refused: it stays, and is said
     x, y = spot or free_spot(b.pickup.area, b.seen)
-    set_down_on_mat(b, x, y, o.grasp_yaw, o.grasp_z - st.surface_z, o.width)
-    b.pending_stale = True  # the mat changed: the next pick looks again
+    b.pending_stale = True  # the mat changed (or what fell on the way lies somewhere): look again
+    if not set_down_on_mat(b, x, y, o.grasp_yaw, o.grasp_z - st.surface_z, o.width):
+        return None
     return x, y
 
 
