@@ -449,7 +449,9 @@ def test_one_of_two_that_falls_back_onto_the_scale_on_the_way_is_fetched_too(con
     # the put back's grasp takes one of the pair off the pan, and it slips out on the way to
     # the mat, back onto the pan: both still lie there. Each is fetched and set down apart,
     # nothing is said to lie where nothing was let go, and the next sherd's tare finds the pan
-    # empty (not "weighed tared over" a sherd that then goes to the discard box unrecorded)
+    # empty (not "weighed tared over" a sherd that then goes to the discard box unrecorded).
+    # The put back looks before its first grasp: the grasp that lifted the two, repeated
+    # blind, closes on the top one far off its centre
     import rascal_tasks.station_states as station_states
 
     world = World(
@@ -457,16 +459,26 @@ def test_one_of_two_that_falls_back_onto_the_scale_on_the_way_is_fetched_too(con
         [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.29), Sherd("c", 0.20, 0.21, mass=0.015)],
     )
     world.doubles = {"a": "b"}
-    real_repick, fired = station_states.repick, []
+    real_repick, real_blind, fired, blind = (
+        station_states.repick,
+        station_states.grasp_where_set_down,
+        [],
+        [],
+    )
 
-    def slipping(b, index):  # the first repick is the put back's (the pair is weighed first)
-        held = real_repick(b, index)
+    def slipping(b, index, **kw):  # the first repick is the put back's (the pair is weighed first)
+        held = real_repick(b, index, **kw)
         if held and not fired:  # it falls back where it was taken from
-            fired.append(world.held.name)
+            fired.append(len(blind))
             world.slips[world.held.name] = config.stations["scale"].place_at
         return held
 
+    def blind_grasp(*args):
+        blind.append(args[2].name)
+        return real_blind(*args)
+
     monkeypatch.setattr(station_states, "repick", slipping)
+    monkeypatch.setattr(station_states, "grasp_where_set_down", blind_grasp)
     outcome, batch, recorder = _run(config, world)
     assert outcome == "finished"
     assert recorder.status() == {1: "done", 2: "done", 3: "done"}
@@ -477,6 +489,7 @@ def test_one_of_two_that_falls_back_onto_the_scale_on_the_way_is_fetched_too(con
     (put_back,) = [n for n in notes if n.startswith("put_back: ")]
     assert len(re.findall(r"\(([-\d.]+), ([-\d.]+)\) m", put_back)) == 2, put_back
     assert any(n.startswith("dropped: putting two sherds") for n in notes), notes
+    assert fired == [0] and blind, (fired, blind)  # no blind grasp in the put back; later ones
     assert all(s.station == "discard" for s in world.sherds)
 
 
