@@ -170,6 +170,25 @@ TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
   EXPECT_TRUE(sim.groundTruth()[0].held);
 }
 
+TEST(Simulator, FingersClosingAboveASherdAreAMissOnRecord) {
+  // closed 50 mm up over a sherd lying flat: nothing between the fingers. The miss is on record
+  // with what each finger touched (nothing) and the sherd below, for the node's log
+  SimulatorOptions o = quiet();
+  o.initial_joints = pointingDownAt(0.30, 0.20, 0.05);
+  Simulator sim(layout(), o);
+  SherdSpec s = slab("c", 0.30, 0.20, 1850);
+  s.pose.z() = std::atan2(0.20, 0.30);
+  closeOn(sim, s);
+  EXPECT_FALSE(sim.groundTruth()[0].held);
+  const Simulator::GraspRecord& g = sim.lastGrasp();
+  EXPECT_EQ(g.count, 1);
+  EXPECT_TRUE(g.miss);
+  EXPECT_EQ(g.sherd, "c");
+  EXPECT_TRUE(g.left.empty() && g.right.empty());
+  EXPECT_LT(g.high, g.ee_z - 0.03);
+  EXPECT_NE(g.describe().find("left touched nothing, right nothing"), std::string::npos) << g.describe();
+}
+
 TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {
   SimulatorOptions o = quiet();
   o.initial_joints = overSherd();

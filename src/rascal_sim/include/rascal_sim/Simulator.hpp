@@ -107,17 +107,25 @@ class Simulator {
   bool triggerCapture(std::string& why, double exposure_ev = 0.0);
   static constexpr double kMaxExposureEv = 3.0;
 
-  /// The last grasp the fingers made and how likely it was to slip (simulator's model): for the
-  /// node's log, so a run's drops can be traced to their grasps. `count` grows by one a grasp.
+  /// The last close of the fingers: a grasp and how likely it was to slip (simulator's model),
+  /// or a miss and what each finger touched on the way: for the node's log, so a run's drops
+  /// and misses can be traced to their grasps. `count` grows by one a close.
   struct GraspRecord {
     int count = 0;
-    std::string sherd;  ///< its name
+    std::string sherd;  ///< its name; a miss: the sherd nearest the fingers' middle
     double time = 0.0;
     double off_centre = 0.0;  ///< of half the sherd's length, 0..1
     double along = 0.0;       ///< |cos| of the closing direction to the outline's major axis
     double elongation = 0.0;  ///< 1 - width / length of the outline
     double slip_chance = 0.0;
-    /// One line for a log: "grasp of sherd_04 at t=101.29 s: ... slip chance 0.352".
+    bool miss = false;
+    std::string left, right;     ///< a miss: the sherd each finger last touched ("" none)
+    double finger = 0.0;         ///< a miss: where the fingers stopped [m, each from the middle]
+    double ee_z = 0.0;           ///< a miss: ee_gripper_link's height [m]
+    double low = 0.0, high = 0.0;  ///< a miss: the nearest sherd's box, lowest and highest [m]
+    /// One line for a log: "grasp of sherd_04 at t=101.29 s: ... slip chance 0.352", or
+    /// "miss at t=...: fingers stopped at 15.0 mm, left touched sherd_03, right nothing; ...".
+    /// Heights are base_link z (the table's top is not 0).
     std::string describe() const;
   };
   const GraspRecord& lastGrasp() const { return last_grasp_; }
@@ -163,6 +171,9 @@ class Simulator {
   bool slip_armed_ = false;
   double slip_delay_ = 0.0, slip_lifted_since_ = -1.0;
   GraspRecord last_grasp_;
+  int close_left_ = -1, close_right_ = -1;  // what each finger touched during this close
+  bool close_recorded_ = false;             // this close's grasp or miss is in last_grasp_
+  void recordMiss();
   RenderOutput scratch_;
   std::vector<RenderItem> items_;
 };

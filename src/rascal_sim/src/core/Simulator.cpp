@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -96,6 +97,8 @@ void Simulator::commandGripper(double finger_position) {
   const double target = gripper_.target();
   if (target < previous - 1e-6 && target < q - 1e-6) {
     close_armed_ = true;
+    close_left_ = close_right_ = -1;
+    close_recorded_ = false;
     world_->stopIgnoringOverlaps();
   } else if (target > previous + kReleaseStep && std::abs(target - q) > 1e-4) {
     // an open, even to less than where a sherd wedged the fingers (not a stop where they are)
@@ -171,6 +174,11 @@ void Simulator::updateGrasp() {
   }
   open_requested_ = false;
   const FingerContacts& fc = world_->fingerContacts();
+  if (close_armed_ && !close_recorded_) {
+    if (fc.left >= 0) close_left_ = fc.left;
+    if (fc.right >= 0) close_right_ = fc.right;
+    if (!gripper_.closing()) recordMiss();
+  }
   // only a close commanded since the last open grasps (an open to less than where a wedged
   // sherd held the fingers moves them inwards, but must not grasp it again)
   if (!close_armed_ || !gripper_.closing() || fc.left < 0 || fc.left != fc.right) return;
@@ -196,7 +204,16 @@ void Simulator::updateGrasp() {
   double p = 0.02 + 0.5 * off * off + 0.6 * along * along * std::min(1.0, 2.5 * elongation);
   if (s.mass > kMaxPayload) p += 0.9;
   p = std::min(0.98, p);
-  last_grasp_ = {last_grasp_.count + 1, s.name, time(), off, along, elongation, p};
+  GraspRecord r;
+  r.count = last_grasp_.count + 1;
+  r.sherd = s.name;
+  r.time = time();
+  r.off_centre = off;
+  r.along = along;
+  r.elongation = elongation;
+  r.slip_chance = p;
+  last_grasp_ = r;
+  close_recorded_ = true;
   const double u = std::uniform_real_distribution<double>(0.0, 1.0)(rng_);
   slip_armed_ = drop_next_grasp_ || u < p;
   drop_next_grasp_ = false;
@@ -204,8 +221,51 @@ void Simulator::updateGrasp() {
   slip_lifted_since_ = -1.0;
 }
 
+void Simulator::recordMiss() {
+  close_recorded_ = true;
+  const Eigen::Vector3d ee = world_->armPose()[kEeGripperLink].translation();
+  GraspRecord r;
+  r.count = last_grasp_.count + 1;
+  r.time = time();
+  r.miss = true;
+  r.finger = gripper_.position();
+  r.ee_z = ee.z();
+  double nearest = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < world_->sherdCount(); ++i) {
+    const SherdState s = world_->sherd(i);
+    const double d = (s.pose.translation() - ee).head<2>().norm();
+    if (d < nearest) {
+      nearest = d;
+      r.sherd = s.name;
+      r.off_centre = std::min(1.0, d / std::max(1e-3, 0.5 * s.length));
+      r.low = std::numeric_limits<double>::infinity();
+      r.high = -r.low;
+      for (int c = 0; c < 8; ++c) {  // the box's corners
+        const Eigen::Vector3d corner(c & 1 ? 0.5 : -0.5, c & 2 ? 0.5 : -0.5, c & 4 ? 0.5 : -0.5);
+        const double z = (s.pose * corner.cwiseProduct(s.box_size)).z();
+        r.low = std::min(r.low, z);
+        r.high = std::max(r.high, z);
+      }
+    }
+  }
+  const auto name = [this](int i) { return i >= 0 ? world_->sherd(static_cast<size_t>(i)).name : std::string(); };
+  r.left = name(close_left_);
+  r.right = name(close_right_);
+  last_grasp_ = r;
+}
+
 std::string Simulator::GraspRecord::describe() const {
   char line[256];
+  if (miss) {
+    std::snprintf(line, sizeof(line),
+                  "miss at t=%.2f s: fingers stopped at %.1f mm, left touched %s, right %s; nearest "
+                  "sherd %s, %.2f of half its length off its centre, its box from z %.1f to %.1f mm; "
+                  "ee_gripper_link at z %.1f mm",
+                  time, finger * 1000.0, left.empty() ? "nothing" : left.c_str(),
+                  right.empty() ? "nothing" : right.c_str(), sherd.c_str(), off_centre, low * 1000.0,
+                  high * 1000.0, ee_z * 1000.0);
+    return line;
+  }
   std::snprintf(line, sizeof(line),
                 "grasp of %s at t=%.2f s: %.2f of half its length off its centre, closing %.2f "
                 "along its long axis (elongation %.2f): slip chance %.3f",

@@ -4,6 +4,7 @@ sherd up (pickup, repick, recovery, resume). No ROS in here.
 
 import contextlib
 import dataclasses
+import math
 
 from rascal_workcell import urdf_model
 
@@ -157,7 +158,22 @@ def grasp(b, o: Observation, station) -> bool:
     if held and not b.rig.gripper.holding():
         held = False  # slipped out while lifting (survey.account_for_slips looks for it)
         b.lift_slips.append(o)
-    if not held:
+    elif not held:  # said with what it was aimed at: a heap's misses are traced from these
+        b.log(
+            "grasp at (%.3f, %.3f) m on the %s: closed on nothing (ee_gripper_link %.1f mm above "
+            "the surface; the sherd's top %.1f mm, what it lies on %.1f mm; turned %.0f deg, "
+            "opened %.1f mm)"
+            % (
+                o.grasp_x,
+                o.grasp_y,
+                station.name,
+                (o.grasp_z - station.surface_z) * 1000,
+                o.height * 1000,
+                o.support * 1000,
+                math.degrees(o.grasp_turn),
+                o.grasp_width * 1000,
+            )
+        )
         with b.phase("grasping"):
             b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
     return held
