@@ -497,16 +497,18 @@ def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(config,
     # taken from the top of a heap (lying 20 mm up on another), set down on the scale it lies
     # on the pan: the blind grasp at the height it was picked up at closes over it; the fingers
     # go down and close again low over the pan, with no look between (a look and a second
-    # grasp cost ~5 s a station), and the next station's grasp is low at once
+    # grasp cost ~5 s a station), and straight down from where they missed, not up to travel
+    # height first; the next station's grasp is low at once
     import rascal_tasks.manipulation as manipulation
     import rascal_tasks.station_states as station_states
 
-    grasps, looks = [], []
+    grasps, looks, heights = [], [], []
     real, real_look = manipulation.grasp, station_states.survey_at
 
-    def counted(b, o, station):
-        held = real(b, o, station)
+    def counted(b, o, station, **kw):
+        held = real(b, o, station, **kw)
         grasps.append((station.name, held))
+        heights.append(world.at[2])  # where the arm is after it: lifted, or left where it missed
         return held
 
     def look(b, station, *xy):
@@ -523,4 +525,6 @@ def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(config,
     assert outcome == "finished" and rec.status() == {1: "done"}
     first, *later = config.route()[:-1]  # set down at, and picked up again from (not the box)
     assert grasps == [("pickup", True), (first, False), (first, True)] + [(n, True) for n in later]
+    travel = config["arm"]["travel_z"]
+    assert heights[1] < travel and all(h == travel for h in heights[:1] + heights[2:]), heights
     assert looks == []
