@@ -10,7 +10,7 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.failures import SherdFailure, about_this_sherd
 from rascal_tasks.rig import Observation, RigError
-from rascal_tasks.survey import survey_at
+from rascal_tasks.survey import survey_at, taken_off_the_mat
 from rascal_tasks.wrist import route_yaw
 
 # Opening between the fingertips, from the URDF's finger limits (facts §1.4: 30..74 mm).
@@ -148,12 +148,14 @@ def reach(b, o: Observation) -> None:
     b.poised = o
 
 
-def grasp(b, o: Observation, station, lift_on_miss=True) -> bool:
+def grasp(b, o: Observation, station, lift_on_miss=True, taken_for=None) -> bool:
     """Reach for `o` (unless the arm is poised there already: a station brought it while it
     waited), close, lift. The lift is a move of its own, checked at the top: a sherd that slips
     out on the way up falls back where it lay (blended into the carry, it would fall on the
     way, off any station: bench/throughput, session 21). Closed on nothing, the fingers open
     again, and (not `lift_on_miss`) stay where they are, for the caller's next grasp below.
+    A sherd lifted off the pickup mat is noted as gone from where the last survey saw it
+    (survey.taken_off_the_mat; `taken_for`: the survey's detection it was grasped for).
     Raises SherdFailure when the arm refuses the approach or the descent (failures.py)."""
     if b.poised != o:
         with _aiming_at(o, station):
@@ -163,6 +165,9 @@ def grasp(b, o: Observation, station, lift_on_miss=True) -> bool:
         held = b.rig.gripper.close().holding
     if held or lift_on_miss:
         b.move_down(o.grasp_x, o.grasp_y, b.travel_z(), o.grasp_yaw, linear=True)
+    if station is b.pickup and held:
+        # it left the mat, for the edge check; one that slips out now is the slip check's
+        taken_off_the_mat(b, o, taken_for)
     if held and not b.rig.gripper.holding():
         held = False  # slipped out while lifting (survey.account_for_slips looks for it)
         b.lift_slips.append(o)
@@ -187,10 +192,10 @@ def grasp(b, o: Observation, station, lift_on_miss=True) -> bool:
     return held
 
 
-def grasp_retrying(b, o: Observation, station, like=None):
+def grasp_retrying(b, o: Observation, station, like=None, taken_for=None):
     """Grasp `o` at `station`; after a miss, detect again around it and grasp the detection
-    nearest it (or least `like`), up to recovery.max_grasp_attempts in all.
-    Returns (the last observation tried, grasps made, whether it is held)."""
+    nearest it (or least `like`), up to recovery.max_grasp_attempts in all (`taken_for`: as
+    grasp's). Returns (the last observation tried, grasps made, whether it is held)."""
     rec = b.config["recovery"]
     like = like or (lambda c, last: c.distance_to(last.x, last.y))
     for attempt in range(rec["max_grasp_attempts"]):
@@ -199,7 +204,7 @@ def grasp_retrying(b, o: Observation, station, like=None):
             yaw = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
             if yaw != o.grasp_yaw:
                 o = dataclasses.replace(o, grasp_yaw=yaw)
-        if grasp(b, o, station):
+        if grasp(b, o, station, taken_for=taken_for):
             return o, attempt + 1, True
         if attempt + 1 == rec["max_grasp_attempts"]:
             break

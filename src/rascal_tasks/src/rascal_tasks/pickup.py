@@ -18,7 +18,6 @@ from rascal_tasks.survey import (
     gripper_for_camera_over,
     lawnmower,
     survey_at,
-    taken_off_the_mat,
 )
 from rascal_tasks.wrist import route_yaw
 
@@ -46,14 +45,10 @@ class Pickup(BatchState):
                 return "missed"
         b.pending_stale = True
         slips = len(b.lift_slips)
-        o, tries, held = grasp_retrying(b, o, b.pickup)
+        o, tries, held = grasp_retrying(b, o, b.pickup, taken_for=surveyed)
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
         # again (survey.account_for_slips), unless the retry took it at once
         b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
-        if held or len(b.lift_slips) > slips:
-            # it left the mat (a neighbour its grasp shoves lies within the radius: not it);
-            # one that slipped while lifted is the slip check's to look for
-            taken_off_the_mat(b, o, surveyed)
         if held:
             if b.renumber is not None:  # two were put back: this one takes over that number
                 b.sherd, b.renumber = b.renumber, None

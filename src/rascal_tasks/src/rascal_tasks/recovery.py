@@ -6,7 +6,7 @@ from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.survey import survey_at, survey_pickup_area, taken_off_the_mat
+from rascal_tasks.survey import survey_at, survey_pickup_area
 
 
 def unlikeness(c: Observation, length: float, width: float, ref) -> float:
@@ -71,8 +71,6 @@ class Recover(BatchState):
             s, "recovered", "picked up again at the %s, (%.3f, %.3f) m" % (station.name, o.x, o.y)
         )
         s.grasped_as(o, station)
-        if station is b.pickup:
-            taken_off_the_mat(b, o)  # one of the last survey's, if it is (not its neighbour)
         if station is b.pickup and s.station_index < 0:
             # Picked afresh from the pickup area: what is in the gripper now is what gets measured.
             s.seen(o, b.pickup)

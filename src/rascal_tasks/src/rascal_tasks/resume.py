@@ -8,7 +8,7 @@ from rascal_tasks.manipulation import grasp, grasp_retrying
 from rascal_tasks.recovery import unlikeness
 from rascal_tasks.rig import Timings
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.survey import camera_over, survey_at, survey_pickup_area, taken_off_the_mat
+from rascal_tasks.survey import camera_over, survey_at, survey_pickup_area
 
 # ee_gripper_link height above the pickup mat where Home lets go of a sherd found in the fingers
 # after a restart: fingertips 4.4 mm lower, so a sherd up to ~2 cm thick drops a few mm at most.
@@ -180,7 +180,6 @@ class Resume(BatchState):
         o, _tries, held = grasp_retrying(b, min(candidates, key=unlike), b.pickup, like=unlike)
         if not held:
             return False
-        taken_off_the_mat(b, o)  # the survey just made saw it: not to be asked back later
         s.seen(o, b.pickup)
         s.picked_xy = (o.x, o.y)
         text = (
@@ -207,7 +206,6 @@ class Resume(BatchState):
             to -= 1
         for o in sorted(near, key=lambda o: o.distance_to(x, y))[:1]:
             if grasp(b, o, b.pickup):
-                taken_off_the_mat(b, o)
                 s.seen(o, b.pickup)
                 s.picked_xy = (o.x, o.y)
                 s.station_done(to - 1)

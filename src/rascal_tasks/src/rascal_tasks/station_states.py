@@ -10,7 +10,7 @@ from rascal_tasks.failures import SherdFailure
 from rascal_tasks.manipulation import grasp, grasp_where_set_down, release
 from rascal_tasks.rig import Observation
 from rascal_tasks.stations import ScaleStation
-from rascal_tasks.survey import survey_at, taken_off_the_mat
+from rascal_tasks.survey import survey_at
 from rascal_tasks.wrist import station_yaw
 
 # [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
@@ -242,8 +242,7 @@ class PutBack(BatchState):
             # other, the top one is taken apart (set down together they may not fall apart,
             # and the next grasp would take the two again)
             top = self._lying_on_another(*spots[0])
-            if top is not None and grasp(b, top, b.pickup):
-                taken_off_the_mat(b, top)  # set down elsewhere: not asked back where it lay
+            if top is not None and grasp(b, top, b.pickup):  # (not asked back where it lay)
                 spot = self._spot_beside(spots)
                 if self._set_down(*spot, top):
                     spots.append(spot)
