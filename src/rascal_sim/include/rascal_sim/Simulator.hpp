@@ -125,7 +125,8 @@ class Simulator {
     double low = 0.0, high = 0.0;  ///< a miss: the nearest sherd's box, lowest and highest [m]
     /// One line for a log: "grasp of sherd_04 at t=101.29 s: ... slip chance 0.352", or
     /// "miss at t=...: fingers stopped at 15.0 mm, left touched sherd_03, right nothing; ...".
-    /// Heights are base_link z (the table's top is not 0).
+    /// Heights are base_link z, not above the station the sherd lies on (the scale's platform top
+    /// is 25 mm up in config/rascal.yaml).
     std::string describe() const;
   };
   const GraspRecord& lastGrasp() const { return last_grasp_; }
