@@ -101,6 +101,7 @@ rascal_msgs::GripperResult GripperServer::run(const rascal_msgs::GripperGoal& go
   }
   const ros::Time t0 = ros::Time::now();
   const ros::WallTime wall0 = ros::WallTime::now();
+  double start = 0.0;  // [m] left finger when the command went out
   {
     std::unique_lock<std::mutex> lock(mutex_);
     sampled_.wait_for(lock, std::chrono::duration<double>(state_timeout_), [this] { return monitor_.hasSample(); });
@@ -109,6 +110,7 @@ rascal_msgs::GripperResult GripperServer::run(const rascal_msgs::GripperGoal& go
       result.message = "no finger sample from /joint_states; is the driver running?";
       return result;
     }
+    start = monitor_.latest().position;
     monitor_.start(target.finger);
     command(target.finger, monitor_.strokeTime(monitor_.latest().position, target.finger));
   }
@@ -144,6 +146,13 @@ rascal_msgs::GripperResult GripperServer::run(const rascal_msgs::GripperGoal& go
                                                                     : rascal_msgs::GripperResult::TIMEOUT;
       result.holding = decision.holding;
       result.message = decision.reason;
+      // nothing between the fingers stops an open: one that ends short was stopped by something
+      // outside them (or by the servo), which the caller's check of the width will refuse
+      const double short_by = target.finger - monitor_.latest().position;
+      if (target.finger > start && short_by > GripperMonitor::kFingerReached) {
+        ROS_WARN("/rascal/gripper: opening stopped %.1f mm short of its target (left finger at %.1f mm, sent to "
+                 "%.1f mm)", short_by * 1000.0, monitor_.latest().position * 1000.0, target.finger * 1000.0);
+      }
       return result;
     }
     if ((now - last_feedback).toSec() >= 0.05 || now < last_feedback) {

@@ -88,14 +88,16 @@ class SimRig:
         self.procs = []  # the rig's nodes: one that exits while a service is awaited is a fault
         self.clients = []  # `rascal` commands run against the rig: they exit by themselves
         self.own_log_dir = log_dir is None
-        self.log_dir = log_dir or tempfile.mkdtemp(prefix="rascal_sim_rig_")
+        # A folder of its own, also under a shared master's: its ROS_HOME is the rig's. The
+        # detector restores the station backgrounds it finds there (BackgroundStore), and a
+        # rig of another scenario that restored them saw a sherd on the empty scale.
+        self.log_dir = tempfile.mkdtemp(prefix="rascal_sim_rig_", dir=log_dir)
         self.logs = {}
         self.master = None
         if master_env is None:
             self.master = RosMaster(log_dir=self.log_dir)
             self.env = self.master.env
         else:
-            # its own ROS_HOME: what its nodes keep there (the detector's backgrounds) is the rig's
             self.env = dict(master_env, ROS_HOME=self.log_dir)
         try:
             self.run(["rosparam", "load", os.path.join(self.ws, "config", "rascal.yaml")])
