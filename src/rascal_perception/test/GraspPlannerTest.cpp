@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <opencv2/imgproc.hpp>
+
 #include "rascal_perception/GraspPlanner.hpp"
 
 using namespace rascal_perception;
@@ -147,4 +149,44 @@ TEST(GraspPlanner, TurnsASherdTooNarrowToHoldAcrossItsMinorAxis) {
   SherdDetection wider = sherd(0.2, 0.25, 0.0, 0.047, 0.034, 0.012);
   planner.plan(wider, &context);
   EXPECT_NEAR(wider.grasp_width, 0.034 + 0.012, 1e-9);
+}
+
+TEST(GraspPlanner, ClosesUnderTheLowerEndOfASherdLeaningOnAnother) {
+  // 50 x 36 mm along x at (0.2, 0.25), its top rising across its width (the fingers' chord)
+  // from 6 mm to 36 mm: one edge on the table, the other raised on a sherd the splitter saw it
+  // lie on (support 21 mm). The rule alone (21 mm + 60 % of the 15 mm above it) closes the
+  // fingertips at 30 mm: above the lower half of the sherd, the lower finger meets nothing.
+  const PerceptionConfig c = withGripper();
+  const GraspPlanner planner(c);
+  const CrowdedView crowd;
+  cv::Mat height = cv::Mat::zeros(crowd.height.size(), CV_32F);
+  cv::Mat inside = cv::Mat::zeros(crowd.height.size(), CV_8U);
+  const CameraIntrinsics& k = crowd.view.intrinsics;
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d p = crowd.view.base_T_camera * (0.3 * k.ray(u, v));
+      const double dx = p.x() - 0.2, dy = p.y() - 0.25;
+      if (std::fabs(dx) > 0.025 || std::fabs(dy) > 0.018) continue;
+      height.at<float>(v, u) = static_cast<float>(0.006 + (dy + 0.018) / 0.036 * 0.030);
+      inside.at<uint8_t>(v, u) = 255;
+    }
+  }
+  Blob own;
+  own.bounds = cv::boundingRect(inside);
+  own.mask = inside(own.bounds).clone();
+  GraspContext context;
+  context.height = &height;
+  context.view = &crowd.view;
+  context.own = &own;
+  SherdDetection leaning = sherd(0.2, 0.25, 0.0, 0.050, 0.036, 0.036);
+  leaning.support = 0.021;
+  planner.plan(leaning, &context);
+  const double tip = leaning.grasp.translation().z() - c.gripper.fingertip_offset;
+  EXPECT_LT(tip, 0.006 + 0.006 * 0.030 / 0.036);  // under the top within 6 mm of the lower edge
+  EXPECT_GE(tip, c.grasp_tip_clearance - 1e-9);
+  // lying flat, 8 mm thick, the same sherd is taken where the rule says
+  height.setTo(0.008f, inside);
+  SherdDetection flat = sherd(0.2, 0.25, 0.0, 0.050, 0.036, 0.008);
+  planner.plan(flat, &context);
+  EXPECT_NEAR(flat.grasp.translation().z() - c.gripper.fingertip_offset, 0.6 * 0.008, 1e-9);
 }

@@ -63,6 +63,14 @@ class GraspPlanner {
   double holdableChord() const { return minOpening() + config_.held_margin + kChordAllowance; }
 
  private:
+  /// [m] the fingertip height for a grasp along `yaw` across `chord` about `centre`: `tip` (the
+  /// rule of the header), lowered where the sherd's own top near either end of the chord lies
+  /// lower (a sherd leaning on another: the rule's height over the one it rests on closes above
+  /// its middle, or meets only its raised end); never under grasp_tip_clearance.
+  double tipAtChordEnds(double yaw, double chord, const Eigen::Vector2d& centre, double surface, double tip,
+                        double own, const GraspContext& context) const;
+  /// [m] how far in from each end of the chord the sherd's top is read
+  static constexpr double kEndBand = 0.006;
   /// [m] fingertip height above the plane minus what lies under the fingers' footprints.
   double fingerClearance(double yaw, double opening, const Eigen::Vector2d& centre, double surface, double tip,
                          const GraspContext& context) const;

@@ -40,7 +40,7 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
   // from what the sherd rests on (the station, or the sherd under it in a heap: closing lower
   // would take that one too)
   const double own = std::max(s.height - s.support, 0.0);
-  const double tip = s.support + std::max(config_.grasp_height_fraction * own, config_.grasp_tip_clearance);
+  double tip = s.support + std::max(config_.grasp_height_fraction * own, config_.grasp_tip_clearance);
   double yaw = s.yaw;
   Eigen::Vector2d centre = s.centre.head<2>();
   double opening = std::clamp(s.width + config_.grasp_margin, minOpening(), maxOpening());
@@ -48,6 +48,7 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
     struct Candidate {
       double yaw, opening, clear, chord;
       Eigen::Vector2d centre;
+      double tip;
     };
     std::vector<Candidate> candidates;
     double chord0 = 0.0;  // across the minor axis
@@ -65,7 +66,8 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
       if (need > maxOpening()) continue;
       const double open = std::clamp(need, minOpening(), maxOpening());
       const Eigen::Vector2d c = s.centre.head<2>() + across * (lo + hi) / 2;
-      candidates.push_back({y, open, fingerClearance(y, open, c, s.surface, tip, *context), hi - lo, c});
+      const double at = tipAtChordEnds(y, hi - lo, c, s.surface, tip, own, *context);
+      candidates.push_back({y, open, fingerClearance(y, open, c, s.surface, at, *context), hi - lo, c, at});
     }
     // the first clear one the fingers can hold; else the clearest they can hold; else the clearest
     const Candidate* pick = nullptr;
@@ -81,7 +83,7 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
         if ((!holdable || c.chord >= holdableChord()) && (!pick || c.clear > pick->clear)) pick = &c;
       }
     }
-    if (pick) yaw = pick->yaw, centre = pick->centre, opening = pick->opening;
+    if (pick) yaw = pick->yaw, centre = pick->centre, opening = pick->opening, tip = pick->tip;
     s.finger_clearance = pick ? pick->clear : -1.0;
     // a long chord is still the grasp to try (nothing nearer the minor axis is clear), but not
     // offered as clear: the task layer takes other sherds first. A sherd too narrow to hold
@@ -94,6 +96,39 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
                       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY())).toRotationMatrix();
   s.grasp.translation() = Eigen::Vector3d(centre.x(), centre.y(), s.surface + tip + config_.gripper.fingertip_offset);
   s.grasp_width = opening;
+}
+
+double GraspPlanner::tipAtChordEnds(double yaw, double chord, const Eigen::Vector2d& centre, double surface,
+                                    double tip, double own, const GraspContext& ctx) const {
+  if (!ctx.own) return tip;
+  const cv::Mat& height = *ctx.height;
+  const Eigen::Vector2d across(-std::sin(yaw), std::cos(yaw)), along(std::cos(yaw), std::sin(yaw));
+  const Eigen::Isometry3d camera_T_base = ctx.view->base_T_camera.inverse();
+  const Blob& b = *ctx.own;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const double side : {-1.0, 1.0}) {
+    std::vector<float> top;  // the sherd's own heights where this finger meets it
+    for (double t = 0.0; t <= kEndBand + 1e-9; t += 0.002) {
+      for (double u = -kFingerWidth / 2; u <= kFingerWidth / 2 + 1e-9; u += 0.002) {
+        const Eigen::Vector2d p = centre + across * side * (chord / 2 - t) + along * u;
+        const Eigen::Vector3d q = camera_T_base * Eigen::Vector3d(p.x(), p.y(), surface + tip);
+        if (q.z() <= 0.0) continue;
+        const Eigen::Vector2d uv = ctx.view->intrinsics.project(q);
+        const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
+        if (!b.bounds.contains(cv::Point(x, y)) || !b.mask.at<uint8_t>(y - b.bounds.y, x - b.bounds.x)) continue;
+        if (x >= height.cols || y >= height.rows) continue;
+        const float h = height.at<float>(y, x);
+        if (h == h) top.push_back(h);
+      }
+    }
+    if (top.empty()) return tip;  // an end not seen: nothing to go by
+    const size_t k = top.size() * 3 / 4;  // the edge's pixels mixed with the ground read low
+    std::nth_element(top.begin(), top.begin() + k, top.end());
+    lowest = std::min(lowest, static_cast<double>(top[k]));
+  }
+  // as far under the lower end's top as the rule closes under a flat sherd's top
+  const double bite = (1.0 - config_.grasp_height_fraction) * own;
+  return std::max(std::min(tip, lowest - bite), config_.grasp_tip_clearance);
 }
 
 double GraspPlanner::fingerClearance(double yaw, double opening, const Eigen::Vector2d& centre, double surface,
