@@ -184,6 +184,19 @@ TEST(GraspPlanner, ClosesUnderTheLowerEndOfASherdLeaningOnAnother) {
   const double tip = leaning.grasp.translation().z() - c.gripper.fingertip_offset;
   EXPECT_LT(tip, 0.006 + 0.006 * 0.030 / 0.036);  // under the top within 6 mm of the lower edge
   EXPECT_GE(tip, c.grasp_tip_clearance - 1e-9);
+  // standing steeper than 45 degrees (its top rising 44 mm across the 36 mm chord) it keeps the
+  // rule's height: pinched by its lower edge it would hang from the fingers
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      if (!inside.at<uint8_t>(v, u)) continue;
+      const Eigen::Vector3d p = crowd.view.base_T_camera * (0.3 * k.ray(u, v));
+      height.at<float>(v, u) = static_cast<float>(0.006 + (p.y() - 0.25 + 0.018) / 0.036 * 0.044);
+    }
+  }
+  SherdDetection steep = sherd(0.2, 0.25, 0.0, 0.050, 0.036, 0.050);
+  steep.support = 0.021;
+  planner.plan(steep, &context);
+  EXPECT_NEAR(steep.grasp.translation().z() - c.gripper.fingertip_offset, 0.021 + 0.6 * (0.050 - 0.021), 1e-9);
   // lying flat, 8 mm thick, the same sherd is taken where the rule says
   height.setTo(0.008f, inside);
   SherdDetection flat = sherd(0.2, 0.25, 0.0, 0.050, 0.036, 0.008);

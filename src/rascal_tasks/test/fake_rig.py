@@ -45,6 +45,9 @@ class Sherd:
     # sweep of the fingers through it below its top lays it flat, unless it is `wedged`
     standing: bool = False
     wedged: bool = False
+    # picked up leaning steeply, it hangs from the fingers by its lower edge and stands where it
+    # is first set down on a station
+    stands_when_set_down: bool = False
     # the fingers close on it this wide (a chord across longer than its width seen from above:
     # a grasp turned to clear neighbours); None: its width
     held_width: Optional[float] = None
@@ -116,6 +119,8 @@ class World:
         st = self.station_at(x, y)
         s.x, s.y, s.station = x, y, st.name if st else None
         s.support = 0.0
+        if s.stands_when_set_down and st is not None and st.name != "pickup":
+            s.standing, s.stands_when_set_down = True, False
 
     def sweep(self, a, b, z):
         """The closed fingers moved level from `a` to `b` at ee height `z`: a standing sherd whose
@@ -125,8 +130,9 @@ class World:
         n = math.hypot(dx, dy)
         if n == 0:
             return
-        for s in self.lying("pickup"):
-            top = self.config.stations["pickup"].surface_z + s.width
+        st = self.station_at(*a)
+        for s in self.lying(st.name if st else "pickup"):
+            top = self.config.stations[s.station].surface_z + s.width
             t = ((s.x - a[0]) * dx + (s.y - a[1]) * dy) / n
             off = abs((s.x - a[0]) * dy - (s.y - a[1]) * dx) / n
             if not s.standing or s.wedged or not 0 < t < n or off > 0.01 or z - FINGERTIP > top:
@@ -201,8 +207,9 @@ class _Gripper(rig.Gripper):
         lying = self.w.lying(st.name if st else None)
         for s in sorted(lying, key=lambda s: -s.support):  # the top one of a stack
             if math.hypot(s.x - x, s.y - y) < 0.01 and z <= st.surface_z + s.support + s.height:
-                if self.w.bad_holds.get(s.name, 0) > 0:
-                    self.w.bad_holds[s.name] -= 1
+                if s.standing or self.w.bad_holds.get(s.name, 0) > 0:  # standing: too thin across
+                    if not s.standing:
+                        self.w.bad_holds[s.name] -= 1
                     break
                 self.w.held, self.w.grasped_at = s, (x, y)
                 knocked = self.w.knock_off.pop(s.name, None)

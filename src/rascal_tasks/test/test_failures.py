@@ -188,6 +188,20 @@ def test_a_sherd_standing_on_its_edge_is_pushed_over_and_recorded(config):
     assert len(batch.pushed) == 1
 
 
+def test_a_sherd_set_down_standing_on_its_edge_at_a_station_is_pushed_over_and_picked_up(config):
+    # picked leaning steeply in a heap, it hung from the fingers and stands on the pan: too thin
+    # across to hold, it was recorded lost and left there for the next sherd to be weighed over
+    world = World(
+        config, [Sherd("a", 0.10, 0.22, stands_when_set_down=True), Sherd("b", 0.25, 0.30)]
+    )
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert [s.station for s in world.sherds] == ["discard", "discard"]
+    assert any("laid_flat: standing on its edge on the " in n for n in rec.sherds[1].notes)
+    assert len(batch.pushed) == 1
+
+
 def test_a_standing_sherd_that_will_not_fall_is_pushed_once_and_said(config):
     world = World(
         config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, standing=True, wedged=True)]

@@ -66,11 +66,16 @@ class GraspPlanner {
   /// [m] the fingertip height for a grasp along `yaw` across `chord` about `centre`: `tip` (the
   /// rule of the header), lowered where the sherd's own top near either end of the chord lies
   /// lower (a sherd leaning on another: the rule's height over the one it rests on closes above
-  /// its middle, or meets only its raised end); never under grasp_tip_clearance.
+  /// its middle, or meets only its raised end); never under grasp_tip_clearance, and not for a
+  /// sherd standing steeply (kSteepRise).
   double tipAtChordEnds(double yaw, double chord, const Eigen::Vector2d& centre, double surface, double tip,
                         double own, const GraspContext& context) const;
   /// [m] how far in from each end of the chord the sherd's top is read
   static constexpr double kEndBand = 0.006;
+  /// A sherd whose top rises more than this times the chord from one end to the other (steeper
+  /// than 45 degrees) keeps the rule's height: pinched low it hangs from the fingers by its lower
+  /// edge, and was set down standing on the pan (heap seed 45) or slipped (seed 46).
+  static constexpr double kSteepRise = 1.0;
   /// [m] fingertip height above the plane minus what lies under the fingers' footprints.
   double fingerClearance(double yaw, double opening, const Eigen::Vector2d& centre, double surface, double tip,
                          const GraspContext& context) const;

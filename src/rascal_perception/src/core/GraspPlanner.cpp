@@ -105,7 +105,7 @@ double GraspPlanner::tipAtChordEnds(double yaw, double chord, const Eigen::Vecto
   const Eigen::Vector2d across(-std::sin(yaw), std::cos(yaw)), along(std::cos(yaw), std::sin(yaw));
   const Eigen::Isometry3d camera_T_base = ctx.view->base_T_camera.inverse();
   const Blob& b = *ctx.own;
-  double lowest = std::numeric_limits<double>::infinity();
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
   for (const double side : {-1.0, 1.0}) {
     std::vector<float> top;  // the sherd's own heights where this finger meets it
     for (double t = 0.0; t <= kEndBand + 1e-9; t += 0.002) {
@@ -125,7 +125,9 @@ double GraspPlanner::tipAtChordEnds(double yaw, double chord, const Eigen::Vecto
     const size_t k = top.size() * 3 / 4;  // the edge's pixels mixed with the ground read low
     std::nth_element(top.begin(), top.begin() + k, top.end());
     lowest = std::min(lowest, static_cast<double>(top[k]));
+    highest = std::max(highest, static_cast<double>(top[k]));
   }
+  if (highest - lowest > kSteepRise * chord) return tip;  // standing steeply: not held low
   // as far under the lower end's top as the rule closes under a flat sherd's top
   const double bite = (1.0 - config_.grasp_height_fraction) * own;
   return std::max(std::min(tip, lowest - bite), config_.grasp_tip_clearance);

@@ -149,3 +149,32 @@ def lay_flat(b) -> bool:
             "(%.2f, %.2f)" % (lo.x, lo.y, lo.height * 1000, d[0], d[1]),
         )
     return pushed
+
+
+def lay_flat_at(b, station, x, y) -> bool:
+    """Push over a sherd that the last look at `station` saw standing on its edge within
+    recovery.search_radius of (x, y), where the sherd in progress was set down: one picked
+    leaning steeply in a heap hangs from the fingers by its lower edge and can stand where it
+    is set down, too thin across for the fingers to hold (heap seed 45: recorded lost, left on
+    the pan, the next sherd weighed over it). Once per spot, counted with the pushes; True when
+    pushed (look again)."""
+    near = b.config["recovery"]["search_radius"]
+    seen = b.rig.perception.leftovers(station.name)
+    for lo in seen:
+        key = (round(lo.x, 2), round(lo.y, 2))
+        if not lo.on_edge or math.hypot(lo.x - x, lo.y - y) > near or key in b.pushed:
+            continue
+        if len(b.pushed) >= MAX_PUSHES:
+            return False
+        b.pushed.add(key)
+        d = topple_direction(lo, seen, station.area)
+        if d is None or not topple(b, lo, d):
+            continue
+        b.event(
+            b.sherd,
+            "laid_flat",
+            "standing on its edge on the %s (%.0f mm tall): pushed over towards (%.2f, %.2f)"
+            % (station.name, lo.height * 1000, d[0], d[1]),
+        )
+        return True
+    return False

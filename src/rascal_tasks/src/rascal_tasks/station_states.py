@@ -9,6 +9,7 @@ from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
 from rascal_tasks.manipulation import grasp, grasp_where_set_down, release
 from rascal_tasks.rig import Observation
+from rascal_tasks.singulation import lay_flat_at
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
 from rascal_tasks.wrist import station_yaw
@@ -167,7 +168,8 @@ def repick(b, index, blind=True) -> bool:
     """Pick the sherd in progress up again where it was set down at station `index`: blind
     first (where it was placed, as it was held: grasp_where_set_down; unless the station tried
     that already while it waited, and missed, or not `blind`), then from a fresh look on each
-    miss. False, with the sherd recorded lost, when it could not be taken."""
+    miss (a look that sees it standing on its edge pushes it over first: lay_flat_at). False,
+    with the sherd recorded lost, when it could not be taken."""
     s = b.sherd
     plugin = b.plugins[index]
     st = plugin.lies_at
@@ -181,6 +183,8 @@ def repick(b, index, blind=True) -> bool:
         return True
     for _attempt in range(looks):
         seen = survey_at(b, st, x, y)
+        if not seen and lay_flat_at(b, st, x, y):
+            seen = survey_at(b, st, x, y)
         if not seen:
             break
         o = seen[0]
