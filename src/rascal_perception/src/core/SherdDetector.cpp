@@ -341,6 +341,15 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
       }
       d.covered = part.covered;
       d.support = part.support;
+      const double own = d.height - d.support;
+      if (own > d.width && own >= kStandingHeight * config_.min_sherd_size) {
+        // standing up from what it rests on (on a station: set down hanging from the fingers by
+        // its lower edge); grasped it is held by its foot, or missed: the task layer topples it
+        leave(part.blob, "standing " + std::to_string(static_cast<int>(own * 1000)) +
+                             " mm tall from what it rests on, taller than wide: standing on its edge?",
+              &d);
+        continue;
+      }
       GraspContext around;
       around.height = &height;
       around.view = &view;
