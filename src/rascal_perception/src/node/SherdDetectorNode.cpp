@@ -19,7 +19,7 @@ namespace {
 constexpr const char* kOpticalFrame = "camera_color_optical_frame";
 constexpr size_t kBuffer = 15;  ///< frames kept per stream (0.5 s at 30 Hz)
 constexpr double kPairSlop = 0.015;  ///< [s] colour and depth stamps closer than this are one frame
-constexpr double kTfWait = 0.5;  ///< [s] of wall time for the camera's transform at a frame's stamp
+constexpr double kTfWait = 0.5;  ///< [s] of wall and of ROS time for the camera's transform at a frame's stamp
 /// [s] a kept background older than this is not restored at start-up: the light of another day
 constexpr double kRestoreWithin = 8 * 3600.0;
 
@@ -177,12 +177,15 @@ bool SherdDetectorNode::prepare(const Frame& frame, cv::Mat& rgb, cv::Mat& depth
   }
   const std::string& frame_id = frame.colour->header.frame_id.empty() ? kOpticalFrame : frame.colour->header.frame_id;
   try {
-    // waited for in wall time: the transform's lag is the publisher's (robot_state_publisher
-    // behind on busy cores), and with the simulator as fast as it runs half a second of ROS
-    // time went by in a few milliseconds (stale wrist-camera TF stopped a batch: CI, e2e)
+    // waited for in wall time and in ROS time, whichever lasts longer: the transform's lag is
+    // the publisher's (robot_state_publisher behind on busy cores), and with the simulator as
+    // fast as it runs half a second of ROS time went by in a few milliseconds (stale
+    // wrist-camera TF stopped a batch: e2e); slower than real time, ROS time lasts longer
     const ros::Time stamp = frame.colour->header.stamp;
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kTfWait);
-    while (ros::ok() && ros::WallTime::now() < deadline && !tf_buffer_.canTransform(base_frame_, frame_id, stamp)) {
+    const ros::WallTime wall_deadline = ros::WallTime::now() + ros::WallDuration(kTfWait);
+    const ros::Time ros_deadline = ros::Time::now() + ros::Duration(kTfWait);
+    while (ros::ok() && (ros::WallTime::now() < wall_deadline || ros::Time::now() < ros_deadline) &&
+           !tf_buffer_.canTransform(base_frame_, frame_id, stamp)) {
       ros::WallDuration(0.005).sleep();
     }
     const auto t = tf_buffer_.lookupTransform(base_frame_, frame_id, stamp);
