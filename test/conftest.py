@@ -2,7 +2,8 @@
 master and the database): `db`, a migrated throw-away catalogue, and `rig_factory`, which
 starts the simulator, arm_controller and sherd_detector with rosrun (rig_helpers.start_rig)
 and stops every rig it started. A failed test's report ends with each rig's node output
-(the simulator's grasp, miss and release lines say what the batch's output cannot)."""
+(the simulator's grasp and miss lines, the controller's warnings: what the batch's output
+cannot say)."""
 
 import pytest
 from rig_helpers import SMALL, migrate, start_rig
