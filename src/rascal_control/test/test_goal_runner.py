@@ -1,5 +1,6 @@
-"""Core tests of goal_runner.node_answers, the liveness check of an action server's node (no ROS
-master: a fake master and fake nodes on XML-RPC)."""
+"""Core tests of goal_runner (no ROS master): node_answers, the liveness check of an action
+server's node, against a fake master and fake nodes on XML-RPC; and when a server counts as
+ready, against a client's topics and their connections."""
 
 import socket
 import threading
@@ -7,7 +8,7 @@ from xmlrpc.server import SimpleXMLRPCServer
 
 import pytest
 
-from rascal_control.goal_runner import node_answers
+from rascal_control.goal_runner import GoalRunner, node_answers
 
 
 def serve(functions):
@@ -59,3 +60,49 @@ def test_a_killed_or_unknown_node_is_gone(graph):
 def test_a_hung_node_or_master_is_asked_again(graph):
     assert node_answers("/hung", graph, timeout=0.2) is None
     assert node_answers("/alive", "http://127.0.0.1:%d/" % free_port()) is False  # no master
+
+
+class _Conn:
+    def __init__(self, callerid_pub):
+        self.callerid_pub = callerid_pub
+
+
+class _Topic:
+    """A rospy publisher or subscriber as GoalRunner reads it: .impl's connections."""
+
+    def __init__(self, *nodes):
+        self.impl = self
+        self.connections = [_Conn(n) for n in nodes]
+
+    def has_connection(self, node):
+        return any(c.callerid_pub == node for c in self.connections)
+
+
+class _Client:
+    def __init__(self, status=(), goal=(), cancel=(), result=(), feedback=()):
+        self.last_status_msg = None
+        self.status_sub, self.result_sub = _Topic(*status), _Topic(*result)
+        self.feedback_sub = _Topic(*feedback)
+        self.pub_goal, self.pub_cancel = _Topic(*goal), _Topic(*cancel)
+
+
+def runner(client):
+    r = object.__new__(GoalRunner)  # no ROS: only the client's topics are read
+    r._client = client
+    return r
+
+
+def test_a_server_whose_topics_are_connected_is_ready_before_its_first_status():
+    ctl = "/arm_controller"
+    r = runner(_Client(status=[ctl], goal=[ctl], cancel=[ctl], result=[ctl], feedback=[ctl]))
+    assert r.server_node() == ctl
+    assert r.missing() == [] and r._server_ready()
+
+
+def test_what_is_not_connected_yet_is_named():
+    ctl = "/arm_controller"
+    assert runner(_Client()).missing() == ["status"]
+    # rospy names a connection's publisher "unknown" until its header is read
+    assert runner(_Client(status=["unknown"])).missing() == ["status"]
+    r = runner(_Client(status=[ctl], goal=[ctl], cancel=[ctl], feedback=[ctl]))
+    assert r.missing() == ["result"] and not r._server_ready()

@@ -1,4 +1,5 @@
 // rosrun rascal_control arm_controller: the arm and gripper actions, IK/FK services and the arm's TF.
+#include <cstdio>
 #include <exception>
 
 #include <ros/ros.h>
@@ -6,6 +7,9 @@
 #include "ArmController.hpp"
 
 int main(int argc, char** argv) {
+  // Line by line into a log file too: a rig's log is read while the node runs, and what a
+  // crashed or killed node printed last is what tells why.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   ros::init(argc, argv, "arm_controller");
   ros::NodeHandle private_nh("~");
   try {

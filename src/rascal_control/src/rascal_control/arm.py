@@ -106,8 +106,8 @@ class Arm:
             if not move_client.wait_for_server(rospy.Duration(wait), stop):
                 raise Timeout(
                     TIMEOUT,
-                    "no /rascal/arm/move action server within %.0f s; is "
-                    "arm_controller running?" % wait,
+                    "no /rascal/arm/move action server within %.0f s (not connected: %s); is "
+                    "arm_controller running?" % (wait, ", ".join(move_client.missing())),
                 )
             try:
                 rospy.wait_for_service("/rascal/arm/compute_ik", wait)

@@ -61,6 +61,13 @@ def node_answers(node: str, master_uri: str, timeout: float = ALIVE_PERIOD) -> O
         return False
 
 
+def _publishers(subscriber) -> list:
+    """The nodes a rospy subscriber is connected to (rospy names a connection's publisher
+    "unknown" until its header is read)."""
+    names = (getattr(conn, "callerid_pub", None) for conn in subscriber.impl.connections)
+    return [name for name in names if name and name != "unknown"]
+
+
 class GoalRunner:
     SILENT_CHECKS = 4  # liveness checks in a row without an answer: the node is hung
     SUCCEEDED, LOST = 3, 9  # actionlib_msgs/GoalStatus
@@ -85,10 +92,18 @@ class GoalRunner:
         self._silent = 0  # liveness checks in a row the server's node did not answer
 
     def server_node(self) -> Optional[str]:
-        """The node serving the action (from its status messages); None before the first."""
+        """The node serving the action: the sender of its status messages, or before the first
+        one the node whose status topic this client is connected to. (The server publishes its
+        status on a timer in ROS time; a /clock that starts late or stalls under use_sim_time
+        held actionlib's test, which waits for a status message, for as long: `rascal teach`
+        once gave up after 30 s with the controller up. A goal needs only the connections.)
+        None while neither is there."""
         msg = self._client.last_status_msg
         header = getattr(msg, "_connection_header", None) or {}
-        return header.get("callerid")
+        node = header.get("callerid")
+        if node:
+            return node
+        return next(iter(_publishers(self._client.status_sub)), None)
 
     def server_alive(self) -> bool:
         """False once the server's node is gone, or has not answered SILENT_CHECKS times."""
@@ -101,21 +116,29 @@ class GoalRunner:
         self._silent = self._silent + 1 if answer is None else 0
         return answer is not False and self._silent < self.SILENT_CHECKS
 
-    def _server_ready(self) -> bool:
-        """actionlib's wait_for_server test, once: the server's status seen and every topic of
-        the action connected to it."""
+    def missing(self) -> list:
+        """What keeps the server from being ready: the action's topics not (yet) connected to
+        its node, by name ([] when ready; ["status"] while no server is seen at all)."""
         c = self._client
         server = self.server_node()
         if server is None:
-            return False
-        if not (
-            c.pub_goal.impl.has_connection(server) and c.pub_cancel.impl.has_connection(server)
-        ):
-            return False
-        return all(
-            any(conn.callerid_pub == server for conn in sub.impl.connections)
-            for sub in (c.result_sub, c.feedback_sub)
-        )
+            return ["status"]
+        missing = [
+            name
+            for name, pub in (("goal", c.pub_goal), ("cancel", c.pub_cancel))
+            if not pub.impl.has_connection(server)
+        ]
+        missing += [
+            name
+            for name, sub in (("result", c.result_sub), ("feedback", c.feedback_sub))
+            if server not in _publishers(sub)
+        ]
+        return missing
+
+    def _server_ready(self) -> bool:
+        """actionlib's wait_for_server test, once, but for the status message: every topic of
+        the action connected to the server's node."""
+        return not self.missing()
 
     def wait_for_server(self, timeout, stop: Optional[threading.Event] = None) -> bool:
         """Waits up to `timeout` (rospy.Duration or seconds) of WALL time. (actionlib measures its

@@ -46,8 +46,8 @@ class Gripper:
             if not client.wait_for_server(rospy.Duration(wait), stop):
                 raise Timeout(
                     TIMEOUT,
-                    "no /rascal/gripper action server within %.0f s; is "
-                    "arm_controller running?" % wait,
+                    "no /rascal/gripper action server within %.0f s (not connected: %s); is "
+                    "arm_controller running?" % (wait, ", ".join(client.missing())),
                 )
         self._client = client
         self.last_result: Optional[GripperResult] = None
