@@ -216,14 +216,39 @@ cv::Mat PhotoSegmenter::contrast(const cv::Mat& full, const cv::Mat& background,
   } else {
     // the cloth: the largest of a few k-means colours (seeded; others' RNG untouched) as a
     // start, then the smooth estimate
-    cv::Mat samples = small.reshape(1, static_cast<int>(small.total())), labels, centres;
-    const uint64_t saved_rng = cv::theRNG().state;
-    cv::theRNG().state = 1;
+    // The colours are found on every other cell each way, and every cell is then labelled by
+    // its nearest colour: the clustering was a quarter of the time per photo, and a surface or
+    // a sherd large enough to matter here covers many cells of the quarter.
+    cv::Mat labels, centres;
     const int k = std::max(2, options_.clusters);
-    cv::kmeans(samples, k, labels, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.5), 1,
-               cv::KMEANS_PP_CENTERS, centres);
-    cv::theRNG().state = saved_rng;
-    labels = labels.reshape(1, coarse.height);
+    {
+      cv::Mat sampled;
+      cv::resize(small, sampled, cv::Size((coarse.width + 1) / 2, (coarse.height + 1) / 2), 0, 0, cv::INTER_NEAREST);
+      cv::Mat samples = sampled.reshape(1, static_cast<int>(sampled.total())), sampled_labels;
+      const uint64_t saved_rng = cv::theRNG().state;
+      cv::theRNG().state = 1;
+      cv::kmeans(samples, k, sampled_labels,
+                 cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 0.5), 1, cv::KMEANS_PP_CENTERS,
+                 centres);
+      cv::theRNG().state = saved_rng;
+    }
+    labels.create(coarse, CV_32S);
+    for (int y = 0; y < coarse.height; ++y) {
+      const cv::Vec3f* p = small.ptr<cv::Vec3f>(y);
+      int* l = labels.ptr<int>(y);
+      for (int x = 0; x < coarse.width; ++x) {
+        float nearest = std::numeric_limits<float>::max();
+        for (int c = 0; c < centres.rows; ++c) {
+          const float* m = centres.ptr<float>(c);
+          const float d0 = p[x][0] - m[0], d1 = p[x][1] - m[1], d2 = p[x][2] - m[2];
+          const float d = d0 * d0 + d1 * d1 + d2 * d2;
+          if (d < nearest) {
+            nearest = d;
+            l[x] = c;
+          }
+        }
+      }
+    }
     // the cloth is the colour of the largest connected piece, its cells counted with less
     // weight towards the rim: a photo is framed on the cloth, sherds of the table's colour are
     // many small pieces, and a table around a mat is at the rim
