@@ -129,17 +129,27 @@ def _sweep(b, at_xy, start, end, z, yaw) -> bool:
     return True
 
 
+def _push_over(b, lo, seen, area):
+    """Push the standing sherd `lo` over, once per spot and within the push budget (MAX_PUSHES,
+    shared with the heap's pushes): the direction it was pushed, or None (pushed there before,
+    budget spent, no free side among `seen` in `area`, or the push failed)."""
+    key = (round(lo.x, 2), round(lo.y, 2))
+    if key in b.pushed or len(b.pushed) >= MAX_PUSHES:
+        return None
+    b.pushed.add(key)
+    d = topple_direction(lo, seen, area)
+    if d is None or not topple(b, lo, d):
+        return None
+    return d
+
+
 def lay_flat(b) -> bool:
     """Push over every sherd of the last survey's leftovers that stands on its edge, once per
     spot (counted with the pushes); True when one was pushed (the area is to be surveyed again)."""
     pushed = False
     for lo in b.leftovers:
-        key = (round(lo.x, 2), round(lo.y, 2))
-        if not lo.on_edge or key in b.pushed or len(b.pushed) >= MAX_PUSHES:
-            continue
-        b.pushed.add(key)
-        d = topple_direction(lo, b.leftovers, b.pickup.area)
-        if d is None or not topple(b, lo, d):
+        d = _push_over(b, lo, b.leftovers, b.pickup.area) if lo.on_edge else None
+        if d is None:
             continue
         pushed = True
         b.event(
@@ -161,14 +171,10 @@ def lay_flat_at(b, station, x, y) -> bool:
     near = b.config["recovery"]["search_radius"]
     seen = b.rig.perception.leftovers(station.name)
     for lo in seen:
-        key = (round(lo.x, 2), round(lo.y, 2))
-        if not lo.on_edge or math.hypot(lo.x - x, lo.y - y) > near or key in b.pushed:
+        if not lo.on_edge or math.hypot(lo.x - x, lo.y - y) > near:
             continue
-        if len(b.pushed) >= MAX_PUSHES:
-            return False
-        b.pushed.add(key)
-        d = topple_direction(lo, seen, station.area)
-        if d is None or not topple(b, lo, d):
+        d = _push_over(b, lo, seen, station.area)
+        if d is None:
             continue
         b.event(
             b.sherd,
