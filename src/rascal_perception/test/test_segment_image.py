@@ -237,3 +237,45 @@ def test_json_round_trip_matches_the_table(tmp_path):
         cols = row.split()
         assert int(cols[0]) == s["id"]
         assert abs(float(cols[1]) - s["length_mm"]) < 0.051
+
+
+def test_several_photos_give_a_json_line_each_and_the_worst_exit_code(tmp_path):
+    first, second = (os.path.join(PHOTOS, n) for n in ("img040DSC02176.jpg", "img114SG101831.jpg"))
+    missing = str(tmp_path / "missing.jpg")
+    r = segment(first, missing, "--json", second, cwd=tmp_path)
+    assert r.returncode == 2  # the missing photo; the two others are still segmented
+    lines = [json.loads(line) for line in r.stdout.splitlines()]
+    assert [d["photo"] for d in lines] == [first, second]
+    for d in lines:  # each as the photo alone gives it
+        assert d["sherd_count"] == photo_result(d["photo"])["sherd_count"]
+        assert d["px_per_cm"] == photo_result(d["photo"])["px_per_cm"]
+    assert "missing.jpg' does not exist" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "img040DSC02176_segmented.jpg",
+        "img114SG101831_segmented.jpg",
+    ]
+
+
+def test_several_photos_as_tables_are_titled_each(tmp_path):
+    photos = [os.path.join(PHOTOS, n) for n in ("img040DSC02176.jpg", "img048DSC02186.jpg")]
+    r = segment(*photos, "--format", "table", "--no-overlay")
+    assert r.returncode == max(segment(p, "--json", "-", "--no-overlay").returncode for p in photos)
+    out = r.stdout.splitlines()
+    assert [line for line in out if line.endswith(".jpg")] == photos
+    for p in photos:
+        head = out.index(p)
+        assert out[head + 1].split()[:2] == ["id", "length"]
+        assert photo_result(p)["summary"] in r.stderr
+
+
+@pytest.mark.parametrize(
+    "args",
+    [["--mask", "m.png"], ["--labels", "l.png"], ["--overlay", "o.jpg"], ["--json", "r.json"]],
+)
+def test_a_file_option_with_several_photos_is_one_line_and_exit_2(tmp_path, args):
+    photos = [os.path.join(PHOTOS, n) for n in ("img040DSC02176.jpg", "img114SG101831.jpg")]
+    r = segment(*photos, *args, cwd=tmp_path)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "is one photo's" in lines[0], r.stderr
+    assert list(tmp_path.iterdir()) == []  # nothing written

@@ -33,10 +33,13 @@ bool sameFile(int a, int b) {
 constexpr int kConfident = 0, kDoubtful = 1, kBadInput = 2;
 
 const char* kHelp =
-    "usage: segment_image PHOTO [options]        (options may come before or after the photo)\n"
+    "usage: segment_image PHOTO... [options]     (options may come before or after the photos)\n"
     "\n"
     "Finds every sherd and the 10 cm scale bar (half a chequer of 1 cm squares, half solid) in a\n"
     "photo of sherds on a cloth, and measures each sherd in mm once the bar is found.\n"
+    "Several photos (segment_image tray/*.jpg) are segmented one after another in one run, which\n"
+    "saves the start-up of one run per photo: stdout holds each photo's table under its name, or\n"
+    "one JSON line per photo with \"photo\" last; the FILE options and --report are for one photo.\n"
     "\n"
     "options:\n"
     "  --json [FILE], -j    one JSON object on one line: \"sherds\", a list of one object per sherd\n"
@@ -70,7 +73,8 @@ const char* kHelp =
     "no_scale (no scale bar: sizes in px).\n"
     "exit codes: 0 a confident result; 1 doubtful (no scale bar, a doubtful bar, a sherd\n"
     "flagged, or the background model not trusted: the summary line says which); 2 bad usage or\n"
-    "an unreadable photo (one line on stderr).\n";
+    "an unreadable photo (one line on stderr). With several photos, the worst of theirs; a photo\n"
+    "that cannot be read is named and the others are still segmented.\n";
 
 bool endsWith(std::string s, const std::string& tail) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -170,8 +174,9 @@ void sherdJson(const PhotoResult& r, size_t i, std::ostream& o) {
     << ", \"area_px\": " << s.blob.pixels << ", \"colour\": [" << s.colour[0] << ", " << s.colour[1] << ", " << s.colour[2] << "]}";
 }
 
-/// `--json`: one line, {"sherds": [...], "sherd_count", "px_per_cm", "scale", "summary"}.
-std::string sherdList(const PhotoResult& r) {
+/// `--json`: one line, {"sherds": [...], "sherd_count", "px_per_cm", "scale", "summary"}, and
+/// "photo" last where several photos are segmented at once (a line each).
+std::string sherdList(const PhotoResult& r, const std::string* photo = nullptr) {
   std::ostringstream o;
   twoDecimals(o);
   o << "{\"sherds\": [";
@@ -187,7 +192,9 @@ std::string sherdList(const PhotoResult& r) {
   } else {
     o << "null, \"scale\": \"no scale bar\"";
   }
-  o << ", \"summary\": \"" << escape(summaryOf(r)) << "\"}\n";
+  o << ", \"summary\": \"" << escape(summaryOf(r)) << "\"";
+  if (photo) o << ", \"photo\": \"" << escape(*photo) << "\"";
+  o << "}\n";
   return o.str();
 }
 
@@ -266,6 +273,85 @@ cv::Mat annotate(const cv::Mat& rgb, const PhotoResult& r) {
   }
   return out;
 }
+/// What to write for each photo, from the options.
+struct Output {
+  std::string format;  // what stdout holds: table, json or report
+  std::string json_path, report_path, overlay_path, mask_path, labels_path;
+  bool overlay = true;
+  bool several = false;  // several photos: each one's table is titled, its JSON line names it
+};
+
+/// One photo through the segmentation and out as `out` says: its exit code.
+int segmentPhoto(const std::string& image, const cv::Mat& bg, const PhotoSegmenter& segmenter, const Output& out) {
+  const bool default_overlay = out.overlay && out.overlay_path.empty();
+  const std::string overlay_path =
+      default_overlay ? std::filesystem::path(image).stem().string() + "_segmented.jpg" : out.overlay_path;
+  PhotoResult r;
+  cv::Mat rgb;
+  try {
+    rgb = readRgb(image, "photo");
+    r = segmenter.segment(rgb, bg);
+  } catch (const std::exception& e) {
+    return badUsage(e.what());
+  }
+  try {
+    const std::pair<const std::string*, std::string> files[] = {{&out.json_path, "--json"},
+                                                                {&out.report_path, "--report"}};
+    for (const auto& [path, option] : files) {
+      if (path->empty()) continue;
+      std::ofstream f(*path);
+      if (!(f << (option == "--json" ? sherdList(r) : report(image, rgb, r)))) {
+        throw std::runtime_error("cannot write " + option + " " + *path);
+      }
+    }
+    if (out.format == "json") std::cout << sherdList(r, out.several ? &image : nullptr) << std::flush;
+    if (out.format == "report") std::cout << report(image, rgb, r);
+    if (out.format == "table") {
+      if (out.several) std::cout << image << "\n";
+      table(r, std::cout);
+      if (out.several) std::cout << "\n";
+      std::cout << std::flush;
+    }
+    if (!out.mask_path.empty() && !cv::imwrite(out.mask_path, r.foreground)) {
+      throw std::runtime_error("cannot write --mask " + out.mask_path);
+    }
+    if (!out.labels_path.empty()) {  // the ids of the table and the JSON, for tools that measure each sherd
+      cv::Mat labels = cv::Mat::zeros(rgb.size(), CV_16U);
+      for (size_t i = 0; i < r.sherds.size(); ++i) {
+        cv::drawContours(labels, std::vector<std::vector<cv::Point>>{r.sherds[i].blob.contour}, 0,
+                         cv::Scalar(static_cast<double>(i + 1)), cv::FILLED);
+      }
+      if (!cv::imwrite(out.labels_path, labels)) throw std::runtime_error("cannot write --labels " + out.labels_path);
+    }
+    if (out.overlay) {
+      cv::Mat bgr;
+      cv::cvtColor(annotate(rgb, r), bgr, cv::COLOR_RGB2BGR);
+      bool written = false;
+      try {
+        written = cv::imwrite(overlay_path, bgr);
+      } catch (const cv::Exception&) {
+      }
+      // The default overlay lands in the current folder, which may be read-only: the result is
+      // still good, so that is a warning; an --overlay asked for is an error.
+      if (!written && default_overlay && out.format != "table") {
+        // stdout is JSON for a program: stderr stays empty so merged output still parses
+      } else if (!written && default_overlay) {
+        std::fprintf(stderr, "segment_image: warning: cannot write the overlay %s here; use --overlay FILE or --no-overlay\n",
+                     overlay_path.c_str());
+      } else if (!written) {
+        throw std::runtime_error("cannot write --overlay " + overlay_path);
+      }
+    }
+  } catch (const std::exception& e) {
+    return badUsage(e.what());
+  }
+  // The summary (count, px/cm, doubts) goes to stderr for a person or a log, except when stderr
+  // is the very pipe or file stdout is: there it would spoil the JSON a program parses.
+  if (out.format == "table" || (out.format == "json" && !sameFile(STDOUT_FILENO, STDERR_FILENO))) {
+    std::fprintf(stderr, "segment_image: %s%s\n", out.several ? (image + ": ").c_str() : "", summaryOf(r).c_str());
+  }
+  return doubts(r).empty() ? kConfident : kDoubtful;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -337,67 +423,42 @@ int main(int argc, char** argv) {
   if (json_path == "-") json_path.clear();
   if (report_path == "-") report_path.clear();
   if (optind >= argc) return badUsage("no photo given");
-  if (argc - optind > 1) return badUsage("one photo at a time; got '" + std::string(argv[optind + 1]) + "' too");
-  const std::string image = argv[optind];
-  const bool default_overlay = overlay && overlay_path.empty();
-  if (default_overlay) overlay_path = std::filesystem::path(image).stem().string() + "_segmented.jpg";
+  Output out;
+  out.format = format;
+  out.json_path = json_path;
+  out.report_path = report_path;
+  out.overlay_path = overlay_path;
+  out.mask_path = mask_path;
+  out.labels_path = labels_path;
+  out.overlay = overlay;
+  out.several = argc - optind > 1;
+  if (out.several) {
+    // a FILE names one photo's output; several photos write only to stdout and their overlays
+    const std::pair<const std::string*, std::string> one_file[] = {{&json_path, "--json FILE"},
+                                                                   {&report_path, "--report FILE"},
+                                                                   {&overlay_path, "--overlay FILE"},
+                                                                   {&mask_path, "--mask FILE"},
+                                                                   {&labels_path, "--labels FILE"}};
+    for (const auto& [path, option] : one_file) {
+      if (!path->empty()) {
+        return badUsage(option + " is one photo's; with " + std::to_string(argc - optind) +
+                        " photos leave it out (stdout has every photo; overlays go to PHOTO-STEM_segmented.jpg)");
+      }
+    }
+    if (format == "report") {
+      return badUsage("--report is one photo's; with several photos use --json (one line per photo)");
+    }
+  }
   cv::setNumThreads(1);
-  PhotoResult r;
-  cv::Mat rgb;
+  cv::Mat bg;
   try {
-    rgb = readRgb(image, "photo");
-    const cv::Mat bg = background.empty() ? cv::Mat() : readRgb(background, "--background");
-    r = PhotoSegmenter(options).segment(rgb, bg);
+    if (!background.empty()) bg = readRgb(background, "--background");
   } catch (const std::exception& e) {
     return badUsage(e.what());
   }
-  try {
-    const std::pair<const std::string*, std::string> files[] = {{&json_path, "--json"}, {&report_path, "--report"}};
-    for (const auto& [path, option] : files) {
-      if (path->empty()) continue;
-      std::ofstream f(*path);
-      if (!(f << (option == "--json" ? sherdList(r) : report(image, rgb, r)))) {
-        throw std::runtime_error("cannot write " + option + " " + *path);
-      }
-    }
-    if (format == "json") std::cout << sherdList(r);
-    if (format == "report") std::cout << report(image, rgb, r);
-    if (format == "table") table(r, std::cout);
-    if (!mask_path.empty() && !cv::imwrite(mask_path, r.foreground)) throw std::runtime_error("cannot write --mask " + mask_path);
-    if (!labels_path.empty()) {  // the ids of the table and the JSON, for tools that measure each sherd
-      cv::Mat labels = cv::Mat::zeros(rgb.size(), CV_16U);
-      for (size_t i = 0; i < r.sherds.size(); ++i) {
-        cv::drawContours(labels, std::vector<std::vector<cv::Point>>{r.sherds[i].blob.contour}, 0,
-                         cv::Scalar(static_cast<double>(i + 1)), cv::FILLED);
-      }
-      if (!cv::imwrite(labels_path, labels)) throw std::runtime_error("cannot write --labels " + labels_path);
-    }
-    if (overlay) {
-      cv::Mat bgr;
-      cv::cvtColor(annotate(rgb, r), bgr, cv::COLOR_RGB2BGR);
-      bool written = false;
-      try {
-        written = cv::imwrite(overlay_path, bgr);
-      } catch (const cv::Exception&) {
-      }
-      // The default overlay lands in the current folder, which may be read-only: the result is
-      // still good, so that is a warning; an --overlay asked for is an error.
-      if (!written && default_overlay && format != "table") {
-        // stdout is JSON for a program: stderr stays empty so merged output still parses
-      } else if (!written && default_overlay) {
-        std::fprintf(stderr, "segment_image: warning: cannot write the overlay %s here; use --overlay FILE or --no-overlay\n",
-                     overlay_path.c_str());
-      } else if (!written) {
-        throw std::runtime_error("cannot write --overlay " + overlay_path);
-      }
-    }
-  } catch (const std::exception& e) {
-    return badUsage(e.what());
-  }
-  // The summary (count, px/cm, doubts) goes to stderr for a person or a log, except when stderr
-  // is the very pipe or file stdout is: there it would spoil the JSON a program parses.
-  if (format == "table" || (format == "json" && !sameFile(STDOUT_FILENO, STDERR_FILENO))) {
-    std::fprintf(stderr, "segment_image: %s\n", summaryOf(r).c_str());
-  }
-  return doubts(r).empty() ? kConfident : kDoubtful;
+  // the worst of the photos' codes; a photo that cannot be read does not stop the others
+  int code = kConfident;
+  const PhotoSegmenter segmenter(options);
+  for (int i = optind; i < argc; ++i) code = std::max(code, segmentPhoto(argv[i], bg, segmenter, out));
+  return code;
 }
