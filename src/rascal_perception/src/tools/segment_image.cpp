@@ -367,9 +367,8 @@ int main(int argc, char** argv) {
                                  {"clusters", required_argument, nullptr, 'k'},
                                  {"help", no_argument, nullptr, 'h'},
                                  {nullptr, 0, nullptr, 0}};
-  std::string json_path, report_path, overlay_path, mask_path, labels_path, background;
-  std::string format;  // what stdout holds: table, json or report
-  bool overlay = true;
+  Output out;  // the options say what to write for each photo
+  std::string background;
   PhotoSegmenter::Options options;
   opterr = 0;  // our own one-line messages
   std::vector<char*> args = withJsonFileResolved(argc, argv);
@@ -379,18 +378,18 @@ int main(int argc, char** argv) {
     const std::string arg = optarg ? optarg : "";
     try {
       switch (c) {
-        case 'j': json_path = arg; break;
-        case 'r': report_path = arg; break;
+        case 'j': out.json_path = arg; break;
+        case 'r': out.report_path = arg; break;
         case 'f':
           if (arg != "table" && arg != "json" && arg != "report") {
             return badUsage("bad value '" + arg + "' for --format (table, json or report)");
           }
-          format = arg;
+          out.format = arg;
           break;
-        case 'o': overlay_path = arg; break;
-        case 'n': overlay = false; break;
-        case 'm': mask_path = arg; break;
-        case 'L': labels_path = arg; break;
+        case 'o': out.overlay_path = arg; break;
+        case 'n': out.overlay = false; break;
+        case 'm': out.mask_path = arg; break;
+        case 'L': out.labels_path = arg; break;
         case 'b': background = arg; break;
         case 'l': {
           size_t used = 0;
@@ -413,39 +412,31 @@ int main(int argc, char** argv) {
                       (c == 'l' ? std::string("bar-length (a length in cm, e.g. 10)") : std::string("clusters (2..12)")));
     }
   }
-  if (json_path == "-" && report_path == "-") return badUsage("--json and --report cannot both go to stdout");
-  const std::string asked = json_path == "-" ? "json" : report_path == "-" ? "report" : "";
-  if (!format.empty() && !asked.empty() && format != asked) {
-    return badUsage("--format " + format + " and --" + asked + " - ask for different things on stdout");
+  if (out.json_path == "-" && out.report_path == "-") return badUsage("--json and --report cannot both go to stdout");
+  const std::string asked = out.json_path == "-" ? "json" : out.report_path == "-" ? "report" : "";
+  if (!out.format.empty() && !asked.empty() && out.format != asked) {
+    return badUsage("--format " + out.format + " and --" + asked + " - ask for different things on stdout");
   }
   // A person at a terminal reads the table; a pipe or a file gets what a program reads.
-  if (format.empty()) format = !asked.empty() ? asked : isatty(STDOUT_FILENO) ? "table" : "json";
-  if (json_path == "-") json_path.clear();
-  if (report_path == "-") report_path.clear();
+  if (out.format.empty()) out.format = !asked.empty() ? asked : isatty(STDOUT_FILENO) ? "table" : "json";
+  if (out.json_path == "-") out.json_path.clear();
+  if (out.report_path == "-") out.report_path.clear();
   if (optind >= argc) return badUsage("no photo given");
-  Output out;
-  out.format = format;
-  out.json_path = json_path;
-  out.report_path = report_path;
-  out.overlay_path = overlay_path;
-  out.mask_path = mask_path;
-  out.labels_path = labels_path;
-  out.overlay = overlay;
   out.several = argc - optind > 1;
   if (out.several) {
     // a FILE names one photo's output; several photos write only to stdout and their overlays
-    const std::pair<const std::string*, std::string> one_file[] = {{&json_path, "--json FILE"},
-                                                                   {&report_path, "--report FILE"},
-                                                                   {&overlay_path, "--overlay FILE"},
-                                                                   {&mask_path, "--mask FILE"},
-                                                                   {&labels_path, "--labels FILE"}};
+    const std::pair<const std::string*, std::string> one_file[] = {{&out.json_path, "--json FILE"},
+                                                                   {&out.report_path, "--report FILE"},
+                                                                   {&out.overlay_path, "--overlay FILE"},
+                                                                   {&out.mask_path, "--mask FILE"},
+                                                                   {&out.labels_path, "--labels FILE"}};
     for (const auto& [path, option] : one_file) {
       if (!path->empty()) {
         return badUsage(option + " is one photo's; with " + std::to_string(argc - optind) +
                         " photos leave it out (stdout has every photo; overlays go to PHOTO-STEM_segmented.jpg)");
       }
     }
-    if (format == "report") {
+    if (out.format == "report") {
       return badUsage("--report is one photo's; with several photos use --json (one line per photo)");
     }
   }
