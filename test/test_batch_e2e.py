@@ -228,3 +228,22 @@ def test_a_chip_too_small_to_pick_is_said_and_the_bag_is_not_complete(rig_factor
     at = re.search(r"at \(([-\d.]+), ([-\d.]+)\) m", said[0])
     assert abs(float(at[1]) - x) < 0.005 and abs(float(at[2]) - y) < 0.005, said
     assert "1 object on the pickup mat not taken as sherds" in out, out[-3000:]
+
+
+def test_sherds_narrower_than_the_stock_fingers_close_are_recorded_with_fingertip_pads(
+    rig_factory, db, tmp_path
+):
+    # chips_3: 25 x 21 and 28 x 24 mm sherds, left after 9 closes on nothing by the stock
+    # fingers (30 mm closed), and a 55 x 40 mm one, all held between 7.5 mm pads (15-59 mm)
+    rig = rig_factory(
+        scenario=os.path.join(SCENARIOS, "chips_3.yaml"),
+        archive=tmp_path / "archive",
+        params={"/arm/gripper/fingertip_pads": 0.0075},
+    )
+    truth = ground_truth(rig)
+    code, out = run_batch(rig, db, "E2E-PADS")
+    assert code == exit_codes.COMPLETE, out[-3000:] + rig.tail()
+    recorded = rows(db, "E2E-PADS")
+    assert [r["status"] for r in recorded] == ["done"] * 3, _summary(recorded)
+    assert_masses_match(recorded, truth)
+    assert min(r["length_mm"] for r in recorded) < 30.0, _summary(recorded)

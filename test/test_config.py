@@ -232,3 +232,11 @@ def test_scale_housing_margin_is_the_workcells():
     with open(header) as f:
         value = re.search(r"kScaleHousingMargin = ([0-9.]+);", f.read()).group(1)
     assert float(value) == SCALE_HOUSING_MARGIN
+
+
+def test_the_fingertip_pads_layout_passes_with_the_shipped_one_station_layout_too():
+    pads = os.path.join(WORKSPACE, "config", "layouts", "fingertip_pads.yaml")
+    for over in ([pads], [ONE_STATION, pads]):
+        cfg = load_config(SHIPPED, over=over)
+        assert cfg["arm"]["gripper"]["fingertip_pads"] == 0.0075
+    assert load_config(SHIPPED)["arm"]["gripper"]["fingertip_pads"] == 0.0

@@ -232,3 +232,15 @@ TEST(GripperMonitor, ACancelledCommandDoesNotHold) {
   m.cancel();
   EXPECT_FALSE(m.holding());
 }
+
+TEST(GripperMonitor, WithPadsWidthsAreBetweenThePadsAndTheJointsStayTheUrdfs) {
+  const GripperMonitor m(gripper().withPads(0.0075), GripperMonitor::Settings{0.5, 3.0, 0.002});
+  EXPECT_DOUBLE_EQ(m.target(GripperMonitor::kClose, 0.0).finger, 0.015);  // the joints' own limits
+  EXPECT_DOUBLE_EQ(m.target(GripperMonitor::kOpen, 0.0).finger, 0.037);
+  EXPECT_DOUBLE_EQ(m.target(GripperMonitor::kWidth, 0.021).finger, 0.018);
+  EXPECT_TRUE(m.target(GripperMonitor::kWidth, 0.015).valid);  // closed on the pads
+  EXPECT_FALSE(m.target(GripperMonitor::kWidth, 0.060).valid);  // past 74 - 15 mm
+  GripperMonitor held = m;
+  held.addSample(sample(0.0, 0.018));  // the driver's joints 36 mm apart: a 21 mm chip between
+  EXPECT_NEAR(held.latest().opening, 0.021, 1e-12);
+}

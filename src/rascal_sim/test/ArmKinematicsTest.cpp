@@ -31,3 +31,29 @@ TEST(ArmKinematics, WristCameraLooksAlongTheGripper) {
   EXPECT_TRUE(cam.linear().col(0).isApprox(-Eigen::Vector3d::UnitY(), 1e-9));  // x right
   EXPECT_TRUE(cam.linear().col(1).isApprox(-Eigen::Vector3d::UnitZ(), 1e-9));  // y down
 }
+
+using rascal_sim::LinkBox;
+
+TEST(ArmKinematics, PadsGrowEachFingerBoxTowardsTheOtherFinger) {
+  const auto stock = ArmKinematics::linkBoxes();
+  const auto padded = ArmKinematics::linkBoxes(0.0075);
+  ASSERT_EQ(stock.size(), padded.size());
+  int fingers = 0;
+  for (size_t i = 0; i < stock.size(); ++i) {
+    const double side = stock[i].link == rascal_sim::kLeftFingerLink ? 1.0 : stock[i].link == rascal_sim::kRightFingerLink ? -1.0 : 0.0;
+    const auto inner = [side](const LinkBox& b) {  // the inner face's y in the finger's frame
+      return b.offset.translation().y() - side * b.size.y() / 2.0;
+    };
+    if (side == 0.0) {
+      EXPECT_TRUE(padded[i].size.isApprox(stock[i].size));
+      continue;
+    }
+    ++fingers;
+    EXPECT_NEAR(inner(stock[i]), 0.0, 1e-12);  // the stock face on the joint (30 mm closed)
+    EXPECT_NEAR(inner(padded[i]), -side * 0.0075, 1e-12);
+    // the outer face stays where it was
+    EXPECT_NEAR(padded[i].offset.translation().y() + side * padded[i].size.y() / 2.0,
+                stock[i].offset.translation().y() + side * stock[i].size.y() / 2.0, 1e-12);
+  }
+  EXPECT_EQ(fingers, 2);
+}

@@ -64,6 +64,7 @@ class World:
         self.held: Optional[Sherd] = None
         self.grasped_at = (0.0, 0.0)
         self.at = (0.0, 0.0, 0.3, 0.0)  # ee_gripper_link x, y, z, yaw
+        self.closes: List[tuple] = []  # (x, y) of every close of the fingers
         self.t = 0.0
         self.moves: List[tuple] = []
         self.chains: List[list] = []  # the steps of each move_through (each also in `moves`)
@@ -101,6 +102,10 @@ class World:
         # beyond it is cut by the image border as by the detector: not offered, said as a part
         self.view_radius = VIEW_RADIUS
         self.view_cuts = False
+
+    def closes_at(self, x: float, y: float, within: float = 0.01) -> int:
+        """How many times the fingers closed within `within` of (x, y)."""
+        return sum(math.hypot(cx - x, cy - y) < within for cx, cy in self.closes)
 
     def station_at(self, x, y):
         for st in self.config.stations.values():
@@ -203,6 +208,7 @@ class _Gripper(rig.Gripper):
     def close(self):
         self.w.opening = None
         x, y, z, _ = self.w.at
+        self.w.closes.append((x, y))
         st = self.w.station_at(x, y)
         lying = self.w.lying(st.name if st else None)
         for s in sorted(lying, key=lambda s: -s.support):  # the top one of a stack

@@ -542,3 +542,25 @@ def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(config,
     travel = config["arm"]["travel_z"]
     assert heights[1] < travel and all(h == travel for h in heights[:1] + heights[2:]), heights
     assert looks == []
+
+
+@pytest.mark.parametrize("pads", [0.0, 0.0075])
+def test_a_sherd_shorter_than_the_fingers_close_is_left_at_once_and_said_with_the_fix(
+    config, pads, capsys
+):
+    # 25 x 21 mm: no chord of it reaches the stock fingers' 30 mm (+ the held margin); with
+    # 7.5 mm pads they close to 15 mm and it is picked up like any other
+    config["arm"]["gripper"]["fingertip_pads"] = pads
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("chip", 0.25, 0.30, 0.025, 0.021)])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    said = [ln for ln in capsys.readouterr().out.splitlines() if "batch unpickable" in ln]
+    if pads:
+        assert rec.status() == {1: "done", 2: "done"} and said == []
+    else:
+        assert rec.status() == {1: "done"}
+        assert batch.unpickable == [(0.25, 0.30)]
+        assert [s.station for s in world.sherds] == ["discard", "pickup"]
+        assert len(said) == 1 and "25 x 21 mm is shorter than the fingers" in said[0], said
+        assert "close to 30 mm" in said[0] and "arm.gripper.fingertip_pads" in said[0], said
+        assert world.closes_at(0.25, 0.30) == 0  # no grasp tried

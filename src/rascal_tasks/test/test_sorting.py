@@ -157,6 +157,7 @@ def test_a_bad_bin_is_refused_with_one_line_naming_the_key(data, change, message
 # -- whole batches -------------------------------------------------------------------------------
 def test_every_sherd_goes_into_the_bin_its_rule_names(data):
     cfg = config_from_dict(with_bins(data, small="length < 30 mm", heavy="mass >= 40 g"))
+    cfg["arm"]["gripper"]["fingertip_pads"] = 0.0075  # a 25 mm sherd needs pads to be held
     world = World(
         cfg,
         [

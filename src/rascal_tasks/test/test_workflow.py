@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from rascal_tasks import rig, stations, workflow
-from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING, opening_for
+from rascal_tasks.manipulation import MAX_OPENING, MIN_OPENING, opening_for, openings
 from rascal_tasks.recovery import Recover
 from rascal_tasks.resume import PUT_BACK_HEIGHT, Calibrate, Home, Resume
 from rascal_tasks.selection import in_pick_order
@@ -103,6 +103,20 @@ def test_opening_is_clamped_to_the_gripper():
     assert opening_for(0.010, 0.012) == MIN_OPENING
     assert opening_for(0.040, 0.012) == pytest.approx(0.052)
     assert opening_for(0.070, 0.012) == MAX_OPENING
+
+
+def test_pads_inside_the_fingers_take_two_pads_off_both_limits(data):
+    assert openings(config_from_dict(data)) == pytest.approx((MIN_OPENING, MAX_OPENING))
+    d = copy.deepcopy(data)
+    d["arm"]["gripper"]["fingertip_pads"] = 0.0075
+    padded = openings(config_from_dict(d))
+    assert padded == pytest.approx((0.015, 0.059))
+    assert opening_for(0.021, 0.012, padded) == pytest.approx(0.033)  # a chip, 12 mm over it
+    assert opening_for(0.002, 0.012, padded) == pytest.approx(0.015)
+    assert opening_for(0.070, 0.012, padded) == pytest.approx(0.059)
+    d["arm"]["gripper"]["fingertip_pads"] = 0.015  # the pads would meet before the fingers close
+    with pytest.raises(ValueError, match="arm.gripper.fingertip_pads"):
+        config_from_dict(d)
 
 
 def test_detections_from_two_survey_poses_are_merged():

@@ -25,6 +25,7 @@ struct ControllerParameters {
   bool publish_tf = true;            // arm.publish_tf
   MoveMonitor::Settings move;        // arm.goal_tolerance, arm.settle_timeout, arm.tracking_tolerance
   GripperMonitor::Settings gripper;  // arm.gripper.stroke_time, timeout, held_margin
+  double fingertip_pads = 0.0;       // [m] arm.gripper.fingertip_pads (GripperGeometry::pad)
   std::vector<rascal_workcell::FixtureBox> fixtures;  // Workcell::collisionBoxes() of stations.*
 
   // Reads every key the schema lists for "arm_controller" and checks that none is left unread.

@@ -17,7 +17,8 @@ struct FingerSample {
   double t = 0.0;         // [s] the driver's stamp (arrival time if it has none)
   double position = 0.0;  // [m] left_finger from the centreline
   double velocity = std::numeric_limits<double>::quiet_NaN();  // [m/s] left_finger; NaN: none sent
-  double opening = 0.0;   // [m] between the fingers (left - right, or 2 x left without right_finger)
+  double opening = 0.0;   // [m] between the finger joints (left - right, or 2 x left); in the
+                          // monitor's history, between the fingers (less the pads: addSample)
 };
 
 class GripperMonitor {

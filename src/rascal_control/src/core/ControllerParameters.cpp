@@ -44,6 +44,7 @@ ControllerParameters ControllerParameters::read(const rascal_workcell::Parameter
   c.gripper.timeout = p.number("arm.gripper.timeout");
   c.gripper.stroke_time = p.number("arm.gripper.stroke_time");
   c.gripper.held_margin = p.number("arm.gripper.held_margin");
+  c.fingertip_pads = p.number("arm.gripper.fingertip_pads");
   c.fixtures = rascal_workcell::Workcell::fromParameters(p).collisionBoxes();
   p.checkAllRead();
   return c;

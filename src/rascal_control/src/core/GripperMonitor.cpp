@@ -38,7 +38,7 @@ GripperMonitor::Target GripperMonitor::target(int command, double width) const {
     return t;
   }
   t.valid = true;
-  t.finger = std::min(gripper_.finger_max, std::max(gripper_.finger_min, width / 2.0));
+  t.finger = std::min(gripper_.finger_max, std::max(gripper_.finger_min, gripper_.fingerFor(width)));
   return t;
 }
 
@@ -52,6 +52,8 @@ void GripperMonitor::addSample(const FingerSample& sample) {
     known_ = false;
   }
   history_.push_back(sample);
+  // the driver's gap is between the finger joints; the opening is between the pads fitted inside
+  history_.back().opening = gripper_.openingAt(sample.opening);
   while (history_.size() > 2 && history_.front().t < sample.t - kHistory) {
     history_.pop_front();
   }

@@ -23,6 +23,7 @@ ArmController::ArmController(ros::NodeHandle& private_nh) : nh_(private_nh) {
     throw std::runtime_error(std::string("robot description: ") + e.what());
   }
   params_ = ControllerParameters::read(rascal_workcell::parametersFromServer("arm_controller"), *model_);
+  gripper_ = gripper_.withPads(params_.fingertip_pads);
   ik_ = std::make_unique<IkSolver>(*model_);
   collisions_ = std::make_unique<CollisionChecker>(*model_, gripper_.finger_max);
   collisions_->addFixtures(params_.fixtures);

@@ -30,6 +30,19 @@ def _urdf_xml() -> Optional[str]:
         return None
 
 
+def _pads() -> float:
+    """arm.gripper.fingertip_pads as the rig's parameter server holds it (0 without one)."""
+    try:
+        import rospy
+
+        if rospy.core.is_initialized():
+            return float(rospy.get_param("/arm/gripper/fingertip_pads", 0.0))
+    except Exception:  # no master, or no rospy: the stock fingers
+        pass
+    return 0.0
+
+
 def opening_limits() -> Tuple[float, float]:
-    """(closed, fully open) distance between the fingertips, metres (30 .. 74 mm on the wx250s)."""
-    return urdf_model.opening_limits(_urdf_xml())
+    """(closed, fully open) distance between the fingertips, metres (30 .. 74 mm on the wx250s,
+    less two pads where arm.gripper.fingertip_pads are fitted)."""
+    return urdf_model.opening_limits(_urdf_xml(), _pads())

@@ -22,7 +22,7 @@ DetectorParameters DetectorParameters::read(const rascal_workcell::Parameters& p
   c.grasp_tip_clearance = p.number("perception.grasp_tip_clearance");
   c.grasp_margin = p.number("arm.grasp_margin");
   c.held_margin = p.number("arm.gripper.held_margin");
-  c.gripper = gripper;
+  c.gripper = gripper.withPads(p.number("arm.gripper.fingertip_pads"));
   d.frame_wait = p.number("perception.frame_wait");
   d.refresh_period = p.number("perception.refresh_period");
   d.workcell = rascal_workcell::Workcell::fromParameters(p);

@@ -141,7 +141,8 @@ double GraspPlanner::fingerClearance(double yaw, double opening, const Eigen::Ve
   double worst = std::numeric_limits<double>::infinity();
   for (const double side : {-1.0, 1.0}) {
     std::vector<float> under;  // heights the finger's footprint looks down on
-    for (double t = 0.0; t <= kFingerThickness + 1e-9; t += 0.002) {
+    // the finger with its pad, from the opening outwards
+    for (double t = 0.0; t <= kFingerThickness + config_.gripper.pad + 1e-9; t += 0.002) {
       for (double u = -kFingerWidth / 2; u <= kFingerWidth / 2 + 1e-9; u += 0.002) {
         const Eigen::Vector2d p = centre + across * side * (opening / 2 + t) + along * u;
         const Eigen::Vector3d q = camera_T_base * Eigen::Vector3d(p.x(), p.y(), surface + tip);

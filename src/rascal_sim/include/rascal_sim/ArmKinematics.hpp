@@ -39,6 +39,9 @@ class ArmKinematics {
   static std::array<Eigen::Isometry3d, kArmLinkCount> forward(const JointVector& q, double finger);
   /// The boxes of the moving links (and the base) used for contacts, rendering and view checks.
   static const std::vector<LinkBox>& linkBoxes();
+  /// linkBoxes with a pad of `pad` [m] inside each finger (GripperGeometry::pad): the finger's
+  /// box grows by it towards the other finger.
+  static std::vector<LinkBox> linkBoxes(double pad);
 };
 
 }  // namespace rascal_sim

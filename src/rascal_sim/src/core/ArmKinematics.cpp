@@ -78,6 +78,17 @@ std::array<Isometry3d, kArmLinkCount> ArmKinematics::forward(const JointVector& 
   return T;
 }
 
+std::vector<LinkBox> ArmKinematics::linkBoxes(double pad) {
+  std::vector<LinkBox> boxes = linkBoxes();
+  for (LinkBox& b : boxes) {
+    if (b.link != kLeftFingerLink && b.link != kRightFingerLink) continue;
+    const double inwards = b.link == kLeftFingerLink ? -1.0 : 1.0;  // towards the centreline
+    b.size.y() += pad;
+    b.offset.translation().y() += inwards * pad / 2.0;
+  }
+  return boxes;
+}
+
 const std::vector<LinkBox>& ArmKinematics::linkBoxes() {
   static const std::vector<LinkBox> boxes = [] {
     std::vector<LinkBox> b;

@@ -156,9 +156,9 @@ Scenario ScenarioLoader::parse(const std::string& yaml_text) const {
     o.painted_fraction = number(gen["painted_fraction"], "generate.painted_fraction", o.painted_fraction, 0, 1);
     o.mesh_count = static_cast<int>(number(gen["mesh_count"], "generate.mesh_count", 0, 0, 200));
     o.mesh_file = fragment;
-    o.length_min = number(gen["length_min"], "generate.length_min", o.length_min, 0.02, 0.10);
+    o.length_min = number(gen["length_min"], "generate.length_min", o.length_min, 0.015, 0.10);
     o.length_max = number(gen["length_max"], "generate.length_max", o.length_max, o.length_min, 0.10);
-    o.width_min = number(gen["width_min"], "generate.width_min", o.width_min, 0.02, 0.10);
+    o.width_min = number(gen["width_min"], "generate.width_min", o.width_min, 0.015, 0.10);
     o.width_max = number(gen["width_max"], "generate.width_max", o.width_max, o.width_min, 0.10);
     if (const YAML::Node heap = gen["heap"]) {
       // a bag tipped out: every generated sherd dropped around one spot (ScenarioGenerator)
@@ -220,8 +220,8 @@ Scenario ScenarioLoader::parse(const std::string& yaml_text) const {
           sp.outline.emplace_back(p[0], p[1]);
         }
       } else {
-        const double length = number(n["length"], k + ".length", 0.05, 0.02, 0.10);
-        const double width = number(n["width"], k + ".width", 0.04, 0.02, length);
+        const double length = number(n["length"], k + ".length", 0.05, 0.015, 0.10);
+        const double width = number(n["width"], k + ".width", 0.04, 0.012, length);
         sp.outline = ScenarioGenerator::irregularOutline(length, width, rng);
       }
       s.sherds.push_back(sp);

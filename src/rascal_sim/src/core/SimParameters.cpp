@@ -41,7 +41,7 @@ SimParameters SimParameters::read(const rascal_workcell::Parameters& p,
     }
     c.options.initial_joints[j] = q[j];
   }
-  c.options.gripper = gripper;
+  c.options.gripper = gripper.withPads(p.number("arm.gripper.fingertip_pads"));
   const double finger = p.number("simulator.initial_finger");
   if (finger < gripper.finger_min || finger > gripper.finger_max) {
     std::ostringstream ss;

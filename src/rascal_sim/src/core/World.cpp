@@ -105,6 +105,7 @@ struct World::Impl {
   dJointID hold_joint = nullptr;
   int held = -1;
   FingerContacts contacts_now, contacts_last;
+  std::vector<LinkBox> link_boxes;  // the arm's, the fingers with their pads (GripperGeometry::pad)
   Mesh fixtures;
   std::vector<FixtureBox> boxes;  // the layout's collision boxes, where they really stand
   double time = 0.0;
@@ -270,7 +271,7 @@ struct World::Impl {
     if (!platform) buildPlatform(l.station(StationType::Scale));  // a scale at table height
     // arm: one kinematic body per link that carries boxes
     link_bodies.assign(kArmLinkCount, nullptr);
-    for (const LinkBox& b : ArmKinematics::linkBoxes()) {
+    for (const LinkBox& b : link_boxes) {
       if (!link_bodies[b.link]) {
         link_bodies[b.link] = dBodyCreate(world);
         dBodySetKinematic(link_bodies[b.link]);
@@ -335,6 +336,7 @@ World::World(const WorldLayout& layout, const rascal_workcell::GripperGeometry& 
   w.space = dHashSpaceCreate(nullptr);
   w.contact_group = dJointGroupCreate(0);
   w.boxes = layout.boxes;
+  w.link_boxes = ArmKinematics::linkBoxes(gripper.pad);
   w.buildFixtures(layout);
   w.fixtures.cull_back_faces = true;  // boxes wound outwards, rectangles face up
   w.fixtures.updateBounds();
@@ -520,7 +522,7 @@ void World::renderItems(std::vector<RenderItem>& items, bool include_arm) const 
     items.push_back({&w.sherds[i]->geo.mesh, bodyPose(w.sherds[i]->body), static_cast<int>(10 + i)});
   }
   if (!include_arm) return;
-  const auto& boxes = ArmKinematics::linkBoxes();
+  const auto& boxes = w.link_boxes;
   for (size_t i = 0; i < boxes.size(); ++i) {
     items.push_back({&w.link_meshes[i], w.arm_pose[boxes[i].link] * boxes[i].offset, 2});
   }

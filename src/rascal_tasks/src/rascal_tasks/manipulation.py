@@ -5,6 +5,7 @@ sherd up (pickup, repick, recovery, resume). No ROS in here.
 import contextlib
 import dataclasses
 import math
+from typing import Tuple
 
 from rascal_workcell import urdf_model
 
@@ -13,7 +14,8 @@ from rascal_tasks.rig import Observation, RigError
 from rascal_tasks.survey import survey_at, taken_off_the_mat
 from rascal_tasks.wrist import route_yaw
 
-# Opening between the fingertips, from the URDF's finger limits (facts §1.4: 30..74 mm).
+# Opening between the stock fingertips, from the URDF's finger limits (facts §1.4: 30..74 mm);
+# pads fitted inside the fingers take two pads off both (openings).
 MIN_OPENING, MAX_OPENING = urdf_model.opening_limits()
 # [m] how far the fingertips reach below ee_gripper_link pointing down (the URDF's finger box)
 FINGERTIP_OFFSET = urdf_model.fingertip_offset()
@@ -25,8 +27,16 @@ MIN_WALL = 0.003
 RELEASE_SLACK = 0.002
 
 
-def opening_for(width: float, margin: float) -> float:
-    return min(MAX_OPENING, max(MIN_OPENING, width + margin))
+def openings(config) -> Tuple[float, float]:
+    """(closed, fully open) opening between the fingers of this rig [m]: the stock limits less
+    two arm.gripper.fingertip_pads."""
+    return urdf_model.opening_limits(pads=config["arm"]["gripper"]["fingertip_pads"])
+
+
+def opening_for(width: float, margin: float, limits=(MIN_OPENING, MAX_OPENING)) -> float:
+    """`width` + `margin` within `limits` (openings(config); the stock fingers' by default)."""
+    lo, hi = limits
+    return min(hi, max(lo, width + margin))
 
 
 def release(b, width: float) -> float:
@@ -39,21 +49,22 @@ def release(b, width: float) -> float:
     width to pick it up by again: `width`, or the opening the fingers held it at when wider
     (fingers that had closed on nothing say nothing of the sherd)."""
     margin = b.config["arm"]["grasp_margin"]
+    lo, hi = limits = openings(b.config)
     held = b.rig.gripper.width()
-    target = opening_for(max(width, held), margin)
-    again = max(width, held) if held > MIN_OPENING + RELEASE_SLACK else width
+    target = opening_for(max(width, held), margin, limits)
+    again = max(width, held) if held > lo + RELEASE_SLACK else width
     b.rig.gripper.open(target)
     if b.rig.gripper.width() >= target - RELEASE_SLACK:
         return again
     b.rig.gripper.open()
     got = b.rig.gripper.width()
-    if got < MAX_OPENING - RELEASE_SLACK:
+    if got < hi - RELEASE_SLACK:
         raise RigError(
             "gripper",
             "NOT_RELEASED",
             "the fingers stopped at %.1f mm opening fully to let go of the sherd (sent to "
             "%.1f mm): something holds them; free the fingers, then re-run"
-            % (got * 1000, MAX_OPENING * 1000),
+            % (got * 1000, hi * 1000),
         )
     return again
 
@@ -80,7 +91,7 @@ def approach(b, o: Observation) -> None:
     is low, and the controller's collision check takes them fully open anyway."""
     above = o.grasp_z + b.config["arm"]["approach_offset"]
     b.rig.gripper.open_while(
-        opening_for(o.grasp_width, 0.0),
+        opening_for(o.grasp_width, 0.0, openings(b.config)),
         lambda: b.move_down(o.grasp_x, o.grasp_y, above, o.grasp_yaw),
     )
 
@@ -110,7 +121,7 @@ def placed_observation(b, s, station) -> Observation:
         y,
         station.surface_z + s.grasp_height,
         s.grasp_yaw,
-        opening_for(s.width, b.config["arm"]["grasp_margin"]),
+        opening_for(s.width, b.config["arm"]["grasp_margin"], openings(b.config)),
     )
 
 
@@ -188,7 +199,7 @@ def grasp(b, o: Observation, station, lift_on_miss=True, taken_for=None) -> bool
             )
         )
         with b.phase("grasping"):
-            b.rig.gripper.open(opening_for(o.grasp_width, 0.0))
+            b.rig.gripper.open(opening_for(o.grasp_width, 0.0, openings(b.config)))
     return held
 
 

@@ -8,7 +8,7 @@ from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.config import top_down_reachable
-from rascal_tasks.manipulation import grasp_retrying
+from rascal_tasks.manipulation import grasp_retrying, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
@@ -44,6 +44,8 @@ class Pickup(BatchState):
                 b.pending = []
                 return "missed"
         b.pending_stale = True
+        if too_short_to_hold(b, o):
+            return self.left_unheld(o)
         slips = len(b.lift_slips)
         o, tries, held = grasp_retrying(b, o, b.pickup, taken_for=surveyed)
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
@@ -93,6 +95,21 @@ class Pickup(BatchState):
         )
         return True
 
+    def left_unheld(self, o: Observation) -> str:
+        """Shorter than the fingers close: no chord of it can be held, so it is left at once and
+        said with the fix (stock fingers: 35 closes on nothing for eight 16-25 mm sherds)."""
+        b = self.batch
+        b.unpickable.append((o.x, o.y))
+        b.event(
+            None,
+            "unpickable",
+            "sherd at (%.3f, %.3f) m left in the pickup area: %.0f x %.0f mm is shorter than the "
+            "fingers can hold (they close to %.0f mm); fit fingertip pads "
+            "(arm.gripper.fingertip_pads) for sherds this small, or record it by hand"
+            % (o.x, o.y, o.length * 1000, o.width * 1000, openings(b.config)[0] * 1000),
+        )
+        return "missed"
+
     def sherd_failed(self, failure):
         """Its grasp was refused: it has no number (it never left the mat), and another try
         would be refused too, so it is left for a person at once."""
@@ -106,6 +123,12 @@ class Pickup(BatchState):
             "sherd at (%.3f, %.3f) m left in the pickup area: %s" % (o.x, o.y, failure.reason),
         )
         return "missed"
+
+
+def too_short_to_hold(b, o: Observation) -> bool:
+    """Whether even `o`'s longest chord is too short for the fingers: closed on it, they would
+    stop within arm.gripper.held_margin of closed, which the controller calls holding nothing."""
+    return o.length < openings(b.config)[0] + b.config["arm"]["gripper"]["held_margin"]
 
 
 # Misses this near one spot (its 1 cm grid point) are at that spot: the fingers nudge a sherd

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace rascal_workcell {
 
@@ -39,6 +40,17 @@ GripperGeometry GripperGeometry::fromUrdf(const std::string& urdf_xml) {
   const auto& box = static_cast<const urdf::Box&>(*link->collision->geometry);
   const double end = link->collision->origin.position.x + box.dim.x / 2.0;
   g.fingertip_offset = end - tip->parent_to_joint_origin_transform.position.x;
+  return g;
+}
+
+GripperGeometry GripperGeometry::withPads(double p) const {
+  if (!(p >= 0.0 && p < finger_min)) {
+    throw std::invalid_argument("arm.gripper.fingertip_pads: " + std::to_string(p) +
+                                " m; give each pad's thickness, 0 <= pads < " + std::to_string(finger_min) +
+                                " m (at that the pads meet before the fingers close)");
+  }
+  GripperGeometry g = *this;
+  g.pad = p;
   return g;
 }
 

@@ -99,10 +99,11 @@ def finger_limits(urdf_xml: Optional[str] = None) -> Tuple[float, float]:
     return _limits(FINGER_JOINT, urdf_xml)
 
 
-def opening_limits(urdf_xml: Optional[str] = None) -> Tuple[float, float]:
-    """(closed, fully open) distance between the fingers, metres (facts §1.4: 30 .. 74 mm)."""
+def opening_limits(urdf_xml: Optional[str] = None, pads: float = 0.0) -> Tuple[float, float]:
+    """(closed, fully open) distance between the fingers, metres (facts §1.4: 30 .. 74 mm), with
+    `pads` [m] fitted inside each finger (arm.gripper.fingertip_pads; GripperGeometry::pad)."""
     lo, hi = finger_limits(urdf_xml)
-    return 2.0 * lo, 2.0 * hi
+    return 2.0 * (lo - pads), 2.0 * (hi - pads)
 
 
 def camera_offset(urdf_xml: Optional[str] = None) -> float:
