@@ -130,7 +130,7 @@ def test_a_grasp_turned_off_the_minor_axis_on_the_mat_is_turned_back_at_the_stat
     # yaw 1.0, the sherd's minor axis lies at 1.0 - 30 deg: it is taken up again across it.
     b, _ = _batch(config)
     turn = math.pi / 6
-    turned = Observation(0.1, 0.2, 0.2, 0.06, 0.03, 0.01, 0.1, 0.2, 0.005, 0.2 + turn, 0.06)
+    turned = Observation(0.1, 0.2, 0.2, 0.06, 0.04, 0.01, 0.1, 0.2, 0.005, 0.2 + turn, 0.06)
     s = SherdRecord.picked(b, turned, b.pickup, attempts=1)
     s.placed(config.stations["scale"], 1.0)
     assert math.isclose(s.grasp_yaw, 1.0 - turn)
@@ -142,3 +142,22 @@ def test_a_grasp_turned_off_the_minor_axis_on_the_mat_is_turned_back_at_the_stat
     s = SherdRecord.picked(b, across, b.pickup, attempts=1)
     s.placed(config.stations["scale"], 2.5)
     assert math.isclose(s.grasp_yaw, 2.5)
+
+
+@pytest.mark.parametrize(
+    "pads, width, kept",
+    [(0.0, 0.031, True), (0.0, 0.034, False), (0.0075, 0.0165, True), (0.0075, 0.019, False)],
+)
+def test_a_sherd_too_narrow_across_to_hold_is_taken_up_by_the_chord_it_was_held_by(
+    config, pads, width, kept
+):
+    # held turned 80 degrees (along a longer chord: across its minor axis the fingers would stop
+    # within held_margin of closed, 30 mm stock, 15 mm between 7.5 mm pads), it is taken up again
+    # as it was held, not turned back across
+    config["arm"]["gripper"]["fingertip_pads"] = pads
+    b, _ = _batch(config)
+    turn = math.radians(80)
+    o = Observation(0.1, 0.2, 0.2, 0.045, width, 0.01, 0.1, 0.2, 0.005, 0.2 + turn, 0.06)
+    s = SherdRecord.picked(b, o, b.pickup, attempts=1)
+    s.placed(config.stations["scale"], 1.0)
+    assert math.isclose(s.grasp_yaw, 1.0 if kept else 1.0 - turn)

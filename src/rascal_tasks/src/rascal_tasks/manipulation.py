@@ -33,6 +33,14 @@ def openings(config) -> Tuple[float, float]:
     return urdf_model.opening_limits(pads=config["arm"]["gripper"]["fingertip_pads"])
 
 
+def holdable(config, chord: float) -> bool:
+    """Whether the fingers hold a sherd across a chord of `chord` [m]: closed on it, they stop
+    more than arm.gripper.held_margin wider than closed, what the controller calls holding (the
+    detector's grasp planner keeps 1 mm more in hand when it chooses a chord)."""
+    closed = openings(config)[0]
+    return chord > closed + config["arm"]["gripper"]["held_margin"]
+
+
 def opening_for(width: float, margin: float, limits=(MIN_OPENING, MAX_OPENING)) -> float:
     """`width` + `margin` within `limits` (openings(config); the stock fingers' by default)."""
     lo, hi = limits

@@ -8,7 +8,7 @@ from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.config import top_down_reachable
-from rascal_tasks.manipulation import grasp_retrying, openings
+from rascal_tasks.manipulation import grasp_retrying, holdable, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
@@ -100,13 +100,19 @@ class Pickup(BatchState):
         said with the fix (stock fingers: 35 closes on nothing for eight 16-25 mm sherds)."""
         b = self.batch
         b.unpickable.append((o.x, o.y))
+        pads = b.config["arm"]["gripper"]["fingertip_pads"]
+        fix = (
+            "thicker fingertip pads than the %.1f mm fitted" % (pads * 1000)
+            if pads
+            else "fingertip pads"
+        )
         b.event(
             None,
             "unpickable",
             "sherd at (%.3f, %.3f) m left in the pickup area: %.0f x %.0f mm is shorter than the "
-            "fingers can hold (they close to %.0f mm); fit fingertip pads "
-            "(arm.gripper.fingertip_pads) for sherds this small, or record it by hand"
-            % (o.x, o.y, o.length * 1000, o.width * 1000, openings(b.config)[0] * 1000),
+            "fingers can hold (they close to %.0f mm); fit %s (arm.gripper.fingertip_pads) for "
+            "sherds this small, or record it by hand"
+            % (o.x, o.y, o.length * 1000, o.width * 1000, openings(b.config)[0] * 1000, fix),
         )
         return "missed"
 
@@ -126,9 +132,8 @@ class Pickup(BatchState):
 
 
 def too_short_to_hold(b, o: Observation) -> bool:
-    """Whether even `o`'s longest chord is too short for the fingers: closed on it, they would
-    stop within arm.gripper.held_margin of closed, which the controller calls holding nothing."""
-    return o.length < openings(b.config)[0] + b.config["arm"]["gripper"]["held_margin"]
+    """Whether even `o`'s longest chord is too short for the fingers (manipulation.holdable)."""
+    return not holdable(b.config, o.length)
 
 
 # Misses this near one spot (its 1 cm grid point) are at that spot: the fingers nudge a sherd

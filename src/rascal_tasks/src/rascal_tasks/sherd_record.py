@@ -92,8 +92,16 @@ class SherdRecord:
         its minor axis. A grasp turned off that axis (neighbours in the way on the mat) closes on
         a longer chord nearer its narrow ends, and slips more; on the station nothing is in the
         way, so the next grasp is turned back (heap seed 36: half the model's slip chance of the
-        batch was in such grasps, repeated at each station)."""
+        batch was in such grasps, repeated at each station). Unless it is too narrow across for
+        the fingers to hold (manipulation.holdable): then by the chord it was held by (a chip
+        between fingertip pads; small_10 with pads: taken up across its 16.5 mm four times in
+        vain at the scale, recorded lost and left on the pan)."""
+        from rascal_tasks.manipulation import holdable  # manipulation -> survey -> here
+
         self.where, self.last_xy = station.name, tuple(station.place_at)
+        if self.observation is not None and not holdable(self.batch.config, self.observation.width):
+            self.grasp_yaw, self.turn = yaw, 0.0
+            return
         x, y = self.last_xy
         back = (yaw - self.turn, yaw - self.turn + math.pi)  # the fingers are alike
         self.grasp_yaw = math.remainder(
