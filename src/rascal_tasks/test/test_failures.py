@@ -9,6 +9,7 @@ from types import SimpleNamespace
 
 import pytest
 import yaml
+import fake_rig
 from fake_rig import Recorder, Sherd, World
 
 from rascal_tasks import workflow
@@ -437,6 +438,54 @@ def test_two_sherds_lifted_as_one_are_put_back_apart_and_recorded_a_row_each(con
     assert any("put back apart" in n for r in recorder.sherds.values() for n in r.notes)
     assert recorder.sherds[1].pickup_xy != (0.10, 0.22)  # where its new sherd was picked
     assert all(s.station == "discard" for s in world.sherds)
+
+
+def test_a_light_sherd_riding_on_a_neighbour_is_seen_on_the_scale_and_put_back(config, monkeypatch):
+    # b (5 g) lies against a and rides along on its grasp: 25 g is within what one 50 x 40 mm
+    # sherd with a 7 mm wall can weigh (35 g), so the mass alone cannot tell. a was picked from
+    # among others, so the wrist camera looks at the pan while it settles: two sherds there,
+    # put back apart, a row each (heap_mixed_20 seed 51: 10 g on 29 g, one row, exit 0)
+    world = World(
+        config,
+        [Sherd("a", 0.10, 0.22), Sherd("b", 0.155, 0.22, mass=0.005), Sherd("c", 0.25, 0.30)],
+    )
+    world.doubles = {"a": "b"}
+    looked, detect = [], fake_rig._Perception.detect
+
+    def logging_detect(self, station):
+        looked.append(station)
+        return detect(self, station)
+
+    monkeypatch.setattr(fake_rig._Perception, "detect", logging_detect)
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished"
+    assert recorder.status() == {1: "done", 2: "done", 3: "done"}
+    masses = sorted(round(r.mass, 4) for r in recorder.sherds.values())
+    assert masses == [0.005, 0.02, 0.02]  # never 25 g in one row
+    notes = [n for r in recorder.sherds.values() for n in r.notes]
+    assert any(n.startswith("two_in_one: ") and "sees 2 sherds on the scale" in n for n in notes)
+    assert any("put back apart" in n for n in notes), notes
+    assert "scale" in looked
+    assert all(s.station == "discard" for s in world.sherds)
+
+
+def test_a_sherd_picked_alone_is_not_looked_at_on_the_scale(config, monkeypatch):
+    # spread out (no neighbour within selection.TOUCHING): the scale is not looked at, so a
+    # spread-out batch pays nothing for the check
+    import rascal_tasks.survey as survey
+
+    looked = []
+    real = survey.survey_at
+
+    def logging_survey_at(b, station, *args, **kw):
+        looked.append(station.name)
+        return real(b, station, *args, **kw)
+
+    monkeypatch.setattr(survey, "survey_at", logging_survey_at)
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, mass=0.031)])
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
+    assert "scale" not in looked and looked, looked
 
 
 def test_two_put_back_together_that_stay_one_on_the_other_are_taken_apart(config):

@@ -279,3 +279,25 @@ def test_a_sherd_the_take_up_missed_is_looked_for_before_it_is_grasped_again(con
     outcome, batch, rec = run_batch(config, world)
     assert outcome == "finished" and rec.status() == {1: "done"}
     assert events[:3] == ["grasp", "look", "grasp"], events
+
+
+def test_a_rider_within_the_mass_bound_is_seen_on_the_pan_after_the_shutter(config, monkeypatch):
+    """A 5 g sherd lying against `a` rides along on its grasp (25 g: within the mass bound of a
+    50 x 40 mm sherd). `a` was picked from among others, so during the photo's transfer the
+    wrist camera looks at the pan before the fingers go round it: two there, no photo kept,
+    both put back apart, a row each. The photos show the arm at standby only."""
+    world = World(
+        config,
+        [Sherd("a", 0.10, 0.22), Sherd("b", 0.155, 0.22, mass=0.005), Sherd("c", 0.25, 0.30)],
+    )
+    world.doubles = {"a": "b"}
+    rec = Recorder()
+    shots = _spy_shutters(monkeypatch, rec)
+    outcome, _batch, rec = run_batch(config, world, rec)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done", 3: "done"}
+    assert sorted(round(r.mass, 4) for r in rec.sherds.values()) == [0.005, 0.02, 0.02]
+    notes = [n for r in rec.sherds.values() for n in r.notes]
+    assert any(n.startswith("two_in_one: ") and "sees 2 sherds on the scale" in n for n in notes)
+    assert len(shots) == 4  # the pair's (not kept), then one for each sherd
+    standby = tuple(config["arm"]["standby"])
+    assert all(at[:2] == pytest.approx(standby) for at in world.at_shutter)

@@ -12,7 +12,7 @@ from rascal_tasks.manipulation import grasp_retrying, holdable, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
-from rascal_tasks.selection import covered, same_size
+from rascal_tasks.selection import among_others, covered, same_size
 from rascal_tasks.survey import (
     SAME_SHERD,
     gripper_for_camera_over,
@@ -57,6 +57,7 @@ class Pickup(BatchState):
                 b.sherd.taken_over(o, b.pickup)
             else:
                 b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
+            b.sherd.among_others = among_others(o, b.seen + b.leftovers, SAME_SHERD)
             return "held"
         attempts = b.config["recovery"]["max_grasp_attempts"]
         others, b.pending = b.pending, []  # the area changed under us: survey again

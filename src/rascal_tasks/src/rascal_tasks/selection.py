@@ -19,6 +19,13 @@ TURNED = math.radians(20.0)
 # Two measurements of one sherd agree this well in length and width (one that fell may lie
 # tilted now).
 SAME_SIZE = 0.25
+# [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
+# another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
+STACKED = 0.002
+# [m] edge to edge along the line of centres: a neighbour this close to the sherd grasped may be
+# lifted with it (lying on it unseen, or caught by a finger), so what reaches the scale is looked
+# at (stations.ScaleStation). The survey's lengths, not the outlines: on the safe side.
+TOUCHING = 0.010
 
 
 def same_size(a, b) -> bool:
@@ -26,6 +33,21 @@ def same_size(a, b) -> bool:
     return abs(a.length - b.length) <= SAME_SIZE * b.length and abs(
         a.width - b.width
     ) <= SAME_SIZE * max(b.width, 0.5 * b.length)
+
+
+def among_others(o: Observation, seen: list, same: float) -> bool:
+    """Whether sherd `o`, just picked, lay among others at the survey (`seen`: Observations
+    and Leftovers; one within `same` of it and of its size is itself): on one, partly under
+    one, with no grasp clear of them, or within TOUCHING of one. Its grasp may have lifted a
+    second sherd with it, one within the mass bound too (a 10 g rider lying on a 29 g sherd,
+    heap_mixed_20 seed 51)."""
+    if o.covered > 0.0 or o.support > STACKED or not o.grasp_clear:
+        return True
+    return any(
+        o.distance_to(p.x, p.y) - (o.length + p.length) / 2 < TOUCHING
+        for p in seen
+        if p is not o and not (o.distance_to(p.x, p.y) <= same and same_size(p, o))
+    )
 
 
 def covered(o: Observation) -> bool:

@@ -31,6 +31,8 @@ class SherdRecord:
         self.where = "pickup"  # station it was last seen at
         self.last_xy: Tuple[float, float] = (0.0, 0.0)
         self.picked_xy: Optional[tuple] = None  # where it was picked (None: unknown on resume)
+        # picked from among others (selection.among_others): what reaches the scale is looked at
+        self.among_others = False
         self.drops = 0
         self.mass: Optional[float] = None
         self.bin: Optional[str] = None  # the sorting bin it goes into (stations.DiscardStation)

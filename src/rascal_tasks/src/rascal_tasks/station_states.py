@@ -9,14 +9,11 @@ from rascal_tasks.batch import BatchState
 from rascal_tasks.failures import SherdFailure
 from rascal_tasks.manipulation import grasp, grasp_where_set_down, release
 from rascal_tasks.rig import Observation
+from rascal_tasks.selection import STACKED
 from rascal_tasks.singulation import lay_flat_at
 from rascal_tasks.stations import ScaleStation
 from rascal_tasks.survey import survey_at
 from rascal_tasks.wrist import station_yaw
-
-# [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
-# another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
-STACKED = 0.002
 
 
 class Translate(BatchState):

@@ -14,6 +14,7 @@ from typing import Callable, Dict, List, NamedTuple, Optional, Tuple, Type
 from rascal_tasks.archival import exposure
 from rascal_tasks.archival.exposure import Exposure
 from rascal_tasks.rig import RigError, ScaleReading
+from rascal_tasks.selection import SAME_SIZE
 from rascal_tasks.wrist import standby_yaw
 
 STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
@@ -101,11 +102,14 @@ class StationPlugin:
         Asked once, by REPICK."""
         return False
 
-    def measure_here(self, sherd, measure: Callable[[], str]) -> str:
+    def measure_here(
+        self, sherd, measure: Callable[[], str], look: Callable[[], Optional[str]] = lambda: None
+    ) -> str:
         """For a station that `stays`: the station before measures the sherd lying here,
-        `measure()` (its after_place's work, its outcome returned); this one may work around it
-        meanwhile (the camera over the scale shoots while the pan settles)."""
-        return measure()
+        `look()` first (an outcome that ends it, or None), then `measure()` (its after_place's
+        work, its outcome returned); this one may work around it meanwhile (the camera over the
+        scale shoots while the pan settles)."""
+        return look() or measure()
 
     def make_way(self, sherd) -> None:
         """For a station that `stays`: the sherd was just set down by the station before, the
@@ -424,7 +428,35 @@ class ScaleStation(StationPlugin):
         def weigh():
             return self._weigh(sherd, since)
 
-        return weigh() if after is None else after.measure_here(sherd, weigh)
+        def look():
+            return self._looked_at(sherd, back_to_hover=after is None)
+
+        if after is None:
+            return look() or weigh()
+        return after.measure_here(sherd, weigh, look)
+
+    def _looked_at(self, sherd, back_to_hover: bool) -> Optional[str]:
+        """A sherd picked from among others (SherdRecord.among_others) is looked at on the pan
+        while it settles: "double" when the wrist camera sees two sherds there (`_two_on_pan`;
+        put back once: PutBack), else None, the arm back above the sherd (`back_to_hover`,
+        where the repick's descent starts) and the pan left to settle. A sherd seen as two
+        again after it was put back is one sherd, flagged."""
+        b = self.batch
+        if not sherd.among_others:
+            return None
+        two = self._two_on_pan(sherd)
+        if two and b.put_back_doubles.get(sherd.seq, 0) == 0:
+            b.put_back_doubles[sherd.seq] = 1
+            b.event(sherd, "two_in_one", two)
+            return "double"
+        if two:
+            b.event(sherd, "two_seen", two)
+            sherd.note("looked at on the scale: %s; put back once and seen alike again" % two)
+        if back_to_hover:
+            x, y = sherd.last_xy
+            hover = self.station.surface_z + sherd.grasp_height + b.config["arm"]["approach_offset"]
+            b.move_down(x, y, hover, sherd.grasp_yaw, linear=True)
+        return None
 
     def _weigh(self, sherd, since: float) -> str:
         """after_place's weighing, on the readings from `since` (the sherd set down) on."""
@@ -474,6 +506,44 @@ class ScaleStation(StationPlugin):
             sherd.note("mass checked: %s; put back once and weighed alike again" % too_heavy)
         return "done"
 
+    def _two_on_pan(self, sherd) -> str:
+        """Why the wrist camera's look at the pan shows two sherds where `sherd` was set down
+        (two seen, or one much larger than it was picked as), or "". For a sherd picked from
+        among others (SherdRecord.among_others): a light sherd lying on the one grasped rides
+        along within the mass bound (heap_mixed_20 seed 51: 10 g on 29 g weighed as one row)."""
+        # imported here: survey -> batch imports this module
+        from rascal_tasks.survey import survey_at
+
+        b = self.batch
+        x, y = sherd.last_xy
+        radius = b.config["recovery"]["search_radius"]
+        seen = [c for c in survey_at(b, self.station, x, y) if c.distance_to(x, y) < radius]
+        o = sherd.observation
+        b.log(
+            "sherd %d, picked from among others: the %s looked at, %d seen"
+            % (sherd.seq, self.station.name, len(seen))
+        )
+        if len(seen) >= 2:
+            return "two sherds in one grasp? the wrist camera sees %d sherds on the %s (%s)" % (
+                len(seen),
+                self.station.name,
+                ", ".join("%.0f x %.0f mm" % (c.length * 1000, c.width * 1000) for c in seen),
+            )
+        if len(seen) == 1 and o is not None and _much_larger(seen[0], o):
+            c = seen[0]
+            return (
+                "two sherds in one grasp? the wrist camera sees %.0f x %.0f mm on the %s where a "
+                "sherd of %.0f x %.0f mm was picked"
+                % (
+                    c.length * 1000,
+                    c.width * 1000,
+                    self.station.name,
+                    o.length * 1000,
+                    o.width * 1000,
+                )
+            )
+        return ""
+
     @staticmethod
     def _more_than_one_sherd(sherd, kg: float) -> str:
         """Why `kg` is more than one sherd of the size the wrist camera measured can weigh, or
@@ -497,6 +567,13 @@ class ScaleStation(StationPlugin):
             sherd.note("mass_unstable: %s; the mass recorded before stands" % reason)
         else:
             sherd.record_mass_unstable(reason)
+
+
+def _much_larger(seen, picked) -> bool:
+    """Whether outline `seen` covers more than two sherds' measurements of one can differ by
+    (selection.SAME_SIZE each way): a second sherd beside or on the one `picked`."""
+    grown = (1.0 + SAME_SIZE) ** 2
+    return seen.length * seen.width > grown * picked.length * picked.width
 
 
 class ArmAt(enum.Enum):
@@ -592,9 +669,10 @@ class ArchivalCameraStation(StationPlugin):
         self._standby(sherd)
         return None
 
-    def measure_here(self, sherd, measure):
+    def measure_here(self, sherd, measure, look=lambda: None):
         """Over the scale: the photo shot as soon as the sherd is set down and the arm at
-        standby; during the image's transfer the arm goes back, the fingers round the sherd,
+        standby; during the image's transfer the scale's `look()` runs (a look at the pan for a
+        second sherd: its "double" ends it), the arm goes back, the fingers round the sherd,
         `measure()` (the weighing) runs, and a sherd weighed ('done') is taken up
         (`_take_up`). The capture is kept for after_place, which checks its exposure (a retake
         sets the sherd down again); one that failed is taken again there. Refused before the
@@ -604,10 +682,13 @@ class ArchivalCameraStation(StationPlugin):
 
         def during():
             try:
-                # the fingers go round the sherd without touching it while the pan settles (a
-                # touch would show in the readings and be waited out)
-                self._reach_back(sherd, take_up=False)
-                outcome.append(measure())
+                # the scale's look at the pan for a second sherd, from above, before the fingers
+                # go round the sherd without touching it while the pan settles (a touch would
+                # show in the readings and be waited out)
+                outcome.append(look())
+                if outcome[0] is None:
+                    self._reach_back(sherd, take_up=False)
+                    outcome[0] = measure()
                 if outcome[0] == "done":
                     self._take_up(sherd)
                 else:  # two, or none, on the pan: out of the way, straight up
@@ -628,7 +709,7 @@ class ArchivalCameraStation(StationPlugin):
                     raise
                 b.event(sherd, "capture_failed", "while weighing: %s" % e.reason)
         if not outcome:  # refused before the shutter: nothing ran
-            return measure()
+            return look() or measure()
         if outcome[0] == "done":
             self._shot = Shot(capture)
         elif capture is not None:
