@@ -441,13 +441,17 @@ def test_two_sherds_lifted_as_one_are_put_back_apart_and_recorded_a_row_each(con
 
 
 def test_a_light_sherd_riding_on_a_neighbour_is_seen_on_the_scale_and_put_back(config, monkeypatch):
-    # b (5 g) lies against a and rides along on its grasp: 25 g is within what one 50 x 40 mm
-    # sherd with a 7 mm wall can weigh (35 g), so the mass alone cannot tell. a was picked from
-    # among others, so the wrist camera looks at the pan while it settles: two sherds there,
-    # put back apart, a row each (heap_mixed_20 seed 51: 10 g on 29 g, one row, exit 0)
+    # b (5 g) lies on a's edge and rides along on its grasp: 25 g is within what one 50 x 40 mm
+    # sherd with a 7 mm wall can weigh (35 g), so the mass alone cannot tell. a was picked with
+    # a sherd lying on it, so the wrist camera looks at the pan while it settles: two sherds
+    # there, put back apart, a row each (heap_mixed_20 seed 51: 10 g on 29 g, one row, exit 0)
     world = World(
         config,
-        [Sherd("a", 0.10, 0.22), Sherd("b", 0.155, 0.22, mass=0.005), Sherd("c", 0.25, 0.30)],
+        [
+            Sherd("a", 0.10, 0.22),
+            Sherd("b", 0.13, 0.22, mass=0.005, support=0.01),
+            Sherd("c", 0.25, 0.30),
+        ],
     )
     world.doubles = {"a": "b"}
     looked, detect = [], fake_rig._Perception.detect
@@ -470,8 +474,8 @@ def test_a_light_sherd_riding_on_a_neighbour_is_seen_on_the_scale_and_put_back(c
 
 
 def test_a_sherd_picked_alone_is_not_looked_at_on_the_scale(config, monkeypatch):
-    # spread out (no neighbour within selection.TOUCHING): the scale is not looked at, so a
-    # spread-out batch pays nothing for the check
+    # nothing lay on it (selection.among_others), even with a neighbour beside it: the scale
+    # is not looked at, so a spread-out batch pays nothing for the check
     import rascal_tasks.survey as survey
 
     looked = []
@@ -482,7 +486,7 @@ def test_a_sherd_picked_alone_is_not_looked_at_on_the_scale(config, monkeypatch)
         return real(b, station, *args, **kw)
 
     monkeypatch.setattr(survey, "survey_at", logging_survey_at)
-    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30, mass=0.031)])
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.155, 0.22, mass=0.031)])
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
     assert "scale" not in looked and looked, looked

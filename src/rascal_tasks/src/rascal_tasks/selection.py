@@ -22,10 +22,6 @@ SAME_SIZE = 0.25
 # [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
 # another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
 STACKED = 0.002
-# [m] edge to edge along the line of centres: a neighbour this close to the sherd grasped may be
-# lifted with it (lying on it unseen, or caught by a finger), so what reaches the scale is looked
-# at (stations.ScaleStation). The survey's lengths, not the outlines: on the safe side.
-TOUCHING = 0.010
 
 
 def same_size(a, b) -> bool:
@@ -35,18 +31,19 @@ def same_size(a, b) -> bool:
     ) <= SAME_SIZE * max(b.width, 0.5 * b.length)
 
 
-def among_others(o: Observation, seen: list, same: float) -> bool:
-    """Whether sherd `o`, just picked, lay among others at the survey (`seen`: Observations
-    and Leftovers; one within `same` of it and of its size is itself): on one, partly under
-    one, with no grasp clear of them, or within TOUCHING of one. Its grasp may have lifted a
-    second sherd with it, one within the mass bound too (a 10 g rider lying on a 29 g sherd,
-    heap_mixed_20 seed 51)."""
-    if o.covered > 0.0 or o.support > STACKED or not o.grasp_clear:
+def among_others(o: Observation, seen: list) -> bool:
+    """Whether a second sherd may have come up with `o`, just picked, by what the survey saw
+    (`seen`: Observations and Leftovers): one lying on it (its outline partly covered, or one
+    resting on something, `support`, within reach of its outline), or no grasp whose fingers
+    clear its neighbours. A light one lying on it rides along within the mass bound (10 g on
+    29 g, heap_mixed_20 seed 51). A neighbour merely beside it is not: looking after every sherd
+    within 10 mm of one took 17 looks in 20 sherds of heap_20 seed 45, none seeing two."""
+    if o.covered > 0.0 or not o.grasp_clear:
         return True
     return any(
-        o.distance_to(p.x, p.y) - (o.length + p.length) / 2 < TOUCHING
+        getattr(p, "support", 0.0) > STACKED and o.distance_to(p.x, p.y) < (o.length + p.length) / 2
         for p in seen
-        if p is not o and not (o.distance_to(p.x, p.y) <= same and same_size(p, o))
+        if p is not o
     )
 
 

@@ -14,7 +14,6 @@ from typing import Callable, Dict, List, NamedTuple, Optional, Tuple, Type
 from rascal_tasks.archival import exposure
 from rascal_tasks.archival.exposure import Exposure
 from rascal_tasks.rig import RigError, ScaleReading
-from rascal_tasks.selection import SAME_SIZE
 from rascal_tasks.wrist import standby_yaw
 
 STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
@@ -507,10 +506,12 @@ class ScaleStation(StationPlugin):
         return "done"
 
     def _two_on_pan(self, sherd) -> str:
-        """Why the wrist camera's look at the pan shows two sherds where `sherd` was set down
-        (two seen, or one much larger than it was picked as), or "". For a sherd picked from
-        among others (SherdRecord.among_others): a light sherd lying on the one grasped rides
-        along within the mass bound (heap_mixed_20 seed 51: 10 g on 29 g weighed as one row)."""
+        """Why the wrist camera's look at the pan shows two sherds where `sherd` was set down, or
+        "". For a sherd picked from among others (SherdRecord.among_others): a light sherd lying
+        on the one grasped rides along within the mass bound (heap_mixed_20 seed 51: 10 g on
+        29 g weighed as one row). Two detections, not one outline larger than the sherd was
+        picked as: a sherd partly under another when picked shows whole on the pan (heap_20
+        seed 45: 46 x 28 mm picked, 48 x 44 mm on the pan, one sherd, put back in vain)."""
         # imported here: survey -> batch imports this module
         from rascal_tasks.survey import survey_at
 
@@ -518,7 +519,6 @@ class ScaleStation(StationPlugin):
         x, y = sherd.last_xy
         radius = b.config["recovery"]["search_radius"]
         seen = [c for c in survey_at(b, self.station, x, y) if c.distance_to(x, y) < radius]
-        o = sherd.observation
         b.log(
             "sherd %d, picked from among others: the %s looked at, %d seen"
             % (sherd.seq, self.station.name, len(seen))
@@ -528,19 +528,6 @@ class ScaleStation(StationPlugin):
                 len(seen),
                 self.station.name,
                 ", ".join("%.0f x %.0f mm" % (c.length * 1000, c.width * 1000) for c in seen),
-            )
-        if len(seen) == 1 and o is not None and _much_larger(seen[0], o):
-            c = seen[0]
-            return (
-                "two sherds in one grasp? the wrist camera sees %.0f x %.0f mm on the %s where a "
-                "sherd of %.0f x %.0f mm was picked"
-                % (
-                    c.length * 1000,
-                    c.width * 1000,
-                    self.station.name,
-                    o.length * 1000,
-                    o.width * 1000,
-                )
             )
         return ""
 
@@ -567,13 +554,6 @@ class ScaleStation(StationPlugin):
             sherd.note("mass_unstable: %s; the mass recorded before stands" % reason)
         else:
             sherd.record_mass_unstable(reason)
-
-
-def _much_larger(seen, picked) -> bool:
-    """Whether outline `seen` covers more than two sherds' measurements of one can differ by
-    (selection.SAME_SIZE each way): a second sherd beside or on the one `picked`."""
-    grown = (1.0 + SAME_SIZE) ** 2
-    return seen.length * seen.width > grown * picked.length * picked.width
 
 
 class ArmAt(enum.Enum):
