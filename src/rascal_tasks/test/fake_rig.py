@@ -498,6 +498,16 @@ class Recorder:
         row.mass, row.mass_missing_reason = kg, None
         row.seconds["weigh"] = seconds
 
+    def mass_by_difference(self, seq, kg, weighed):
+        row = self.sherds[seq]
+        if row.status not in ("weighed", "photographed"):
+            raise StatusError(
+                "sherd %d is %r: cannot record a mass by difference" % (seq, row.status)
+            )
+        assert abs(row.mass - weighed) < 1e-9, (row.mass, weighed)
+        row.mass = kg
+        self.writes.append(("mass_by_difference", seq))
+
     def mass_unstable(self, seq, reason, seconds=None):
         row = self._move(seq, "mass_unstable")
         row.mass, row.mass_missing_reason = None, reason

@@ -373,6 +373,30 @@ def test_final_states_cannot_be_changed_but_reweighing_is_allowed(catalogue):
         catalogue.record_drop(s)
 
 
+def test_a_mass_by_difference_corrects_a_sherd_on_its_way_and_keeps_both_figures(
+    catalogue, tmp_path
+):
+    # weighed with a rider that then stayed on the pan: corrected while weighed or
+    # photographed, the event keeps what was weighed; refused once done, and refused bad
+    catalogue.open_context("C1", "site")
+    s = catalogue.new_sherd("C1")["sherd_id"]
+    with pytest.raises(StatusError, match="is 'picked'.*only after weighed, photographed"):
+        catalogue.record_mass_by_difference(s, 7.3, 16.5)
+    catalogue.record_mass(s, 16.5)
+    catalogue.archive_photo(s, ImageArchive(str(tmp_path)), PNG)
+    assert catalogue.get(s)["status"] == "photographed"
+    catalogue.record_mass_by_difference(s, 7.3, 16.5)
+    assert catalogue.get(s)["mass_g"] == 7.3
+    (event,) = [e for e in catalogue.events("C1") if e["kind"] == "mass_by_difference"]
+    assert event["detail"]["mass_g"] == 7.3 and event["detail"]["weighed_g"] == 16.5
+    with pytest.raises(FieldError, match="mass_g"):
+        catalogue.record_mass_by_difference(s, 0.0, 16.5)
+    catalogue.record_done(s)
+    with pytest.raises(StatusError, match="is 'done'"):
+        catalogue.record_mass_by_difference(s, 7.0, 7.3)
+    assert catalogue.get(s)["mass_g"] == 7.3
+
+
 @pytest.mark.parametrize("value", [0, -3.0, float("nan"), float("inf"), "heavy", True, None, 1e6])
 def test_bad_mass_is_refused_naming_the_field_and_nothing_changes(catalogue, value):
     catalogue.open_context("C1", "site")

@@ -96,6 +96,10 @@ class Recorder:
             )
         self.catalogue.record_mass(self._id(seq), kg * 1000.0, t_weigh_s=seconds)
 
+    def mass_by_difference(self, seq, kg: float, weighed: float):
+        """Its own mass [kg]: the `weighed` row less a sherd that stayed on the pan."""
+        self.catalogue.record_mass_by_difference(self._id(seq), kg * 1000.0, weighed * 1000.0)
+
     def mass_unstable(self, seq, reason: str, seconds: float = None):
         """No trustworthy mass: status mass_unstable, no mass, `reason` in mass_missing_reason
         and a note (UNSTABLE_NOTE, which `rascal run`'s summary counts)."""

@@ -136,6 +136,12 @@ class SherdRecord:
         self.batch.recorder.mass(self.seq, kg, True, seconds=self._stage())
         self.mass, self.status = kg, "weighed"
 
+    def record_mass_by_difference(self, kg: float):
+        """Weighed with a sherd that then stayed on the pan: its own mass is the difference
+        (weighed or photographed still; the status stays)."""
+        self.batch.recorder.mass_by_difference(self.seq, kg, self.mass)
+        self.mass = kg
+
     def record_mass_unstable(self, reason: str):
         """The scale gave no trustworthy mass: the row says why and has no mass."""
         self.batch.recorder.mass_unstable(self.seq, reason, seconds=self._stage())

@@ -272,9 +272,10 @@ class ScaleStation(StationPlugin):
     def _left_on_pan(self, kg: float) -> bool:
         """`kg` lies on the pan, settled, since the sherd weighed here was lifted off it: a
         sherd that came with it (lying on it in a heap) and stayed. Its mass was weighed with
-        the sherd's, whose own is the difference (recorded while the sherd is not yet
-        photographed, else noted). The other is taken back to the pickup mat, to be recorded
-        as its own sherd (station_states.clear_to_mat). True when the pan was cleared."""
+        the sherd's, whose own is the difference (recorded while the sherd is not yet done,
+        the catalogue's event keeping both figures; else noted). The other is taken back to
+        the pickup mat, to be recorded as its own sherd (station_states.clear_to_mat). True
+        when the pan was cleared."""
         b = self.batch
         s = self._last  # the sherd in progress, or done since (the camera over the scale)
         itself = s is not None and (
@@ -296,8 +297,10 @@ class ScaleStation(StationPlugin):
                 "%.1f g stayed on the scale when it was lifted off: weighed with it (%.1f g); "
                 "its own mass by difference %.1f g" % (kg * 1000, s.mass * 1000, own * 1000)
             )
-            if own >= MIN_SHERD_MASS and s.status == "weighed":
-                s.record_mass(round(own, 7))
+            # still on its way (not yet done): the row's mass is corrected, the event keeps both
+            # (heap_mixed_20 seed 55: 16.5 g weighed, 7.3 g its own, photographed already)
+            if own >= MIN_SHERD_MASS and s.status in ("weighed", "photographed"):
+                s.record_mass_by_difference(round(own, 7))
                 text += ", recorded"
             b.event(s, "left_on_scale", text)
         # imported here: station_states imports this module

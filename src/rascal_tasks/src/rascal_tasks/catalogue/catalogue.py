@@ -696,6 +696,22 @@ class Catalogue:
             {"mass_g": mass_g},
         )
 
+    def record_mass_by_difference(self, sherd_id, mass_g, weighed_g):
+        """A sherd weighed with another lying on the pan too (a rider from a heap, left there
+        when it was lifted off): its own mass [g] is the row's `weighed_g` less what stayed on
+        the pan. Only while it is still on its way (weighed or photographed); no state change;
+        the event keeps both figures."""
+        mass_g = check_number("mass_g", mass_g, 0.0, 100000.0, "g", allow_none=False, lo_open=True)
+        weighed_g = check_number("weighed_g", weighed_g, 0.0, 100000.0, "g", allow_none=False)
+        return self._advance(
+            sherd_id,
+            "mass_by_difference",
+            ("weighed", "photographed"),
+            {"mass_g": mass_g},
+            None,
+            {"mass_g": mass_g, "weighed_g": weighed_g},
+        )
+
     def record_mass_unstable(self, sherd_id, reason, t_weigh_s=None):
         """The scale gave no mass that can be trusted (no reading held steady, or it could not
         be tared): picked -> mass_unstable, with no mass and ``reason`` in mass_missing_reason.
