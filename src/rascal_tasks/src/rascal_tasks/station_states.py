@@ -86,6 +86,7 @@ class Place(BatchState):
             # out of its way while this one measures (the scale settles meanwhile), as one motion
             b.lift_later(*st.place_at, yaw)
             s.placed(st, yaw)
+            plugin.while_lifting(s)
             after.make_way(s)
             return "placed"
         if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)

@@ -110,6 +110,11 @@ class StationPlugin:
         scale shoots while the pan settles)."""
         return look() or measure()
 
+    def while_lifting(self, sherd) -> None:
+        """The sherd just let go here, the arm about to rise from it, and a station that
+        `stays` works on it next (the camera over the scale): a last look at it before the arm
+        goes out of that one's way (the scale's look for a second sherd)."""
+
     def make_way(self, sherd) -> None:
         """For a station that `stays`: the sherd was just set down by the station before, the
         gripper still low at it, going straight up as the first part of its next move
@@ -185,6 +190,7 @@ class ScaleStation(StationPlugin):
         self._last = None  # the SherdRecord placed on the scale last (it may be done since)
         self._before_tare = 0.0  # kg, what the settled empty pan read before the last tare
         self._early_tare = None  # (clock time, empty reading before it) of while_away's tare
+        self._early_look = None  # (seq, outcome) of while_lifting's look at the pan
 
     def _cfg(self):
         return self.batch.config["scale"]
@@ -431,11 +437,21 @@ class ScaleStation(StationPlugin):
             return self._weigh(sherd, since)
 
         def look():
+            early, self._early_look = self._early_look, None
+            if early is not None and early[0] == sherd.seq:
+                return early[1]  # looked at on the way up from it (while_lifting)
             return self._looked_at(sherd, back_to_hover=after is None)
 
         if after is None:
             return look() or weigh()
         return after.measure_here(sherd, weigh, look)
+
+    def while_lifting(self, sherd):
+        """With the camera over the scale: the look for a second sherd on the way up from it,
+        before the arm goes to standby for the photo (from standby and back cost 2.4 s a look
+        against 0.6 s with the stations apart: heap_20 seed 45, one station)."""
+        if sherd.among_others:
+            self._early_look = (sherd.seq, self._looked_at(sherd, back_to_hover=False))
 
     def _looked_at(self, sherd, back_to_hover: bool) -> Optional[str]:
         """A sherd picked from among others (SherdRecord.among_others) is looked at on the pan
