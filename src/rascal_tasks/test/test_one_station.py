@@ -305,3 +305,28 @@ def test_a_rider_within_the_mass_bound_is_seen_on_the_pan_after_the_shutter(conf
     assert len(shots) == 4  # the pair's (not kept), then one for each sherd
     standby = tuple(config["arm"]["standby"])
     assert all(at[:2] == pytest.approx(standby) for at in world.at_shutter)
+
+
+def test_the_look_for_a_second_sherd_is_made_on_the_way_up_before_the_photo(config):
+    """`a` had a sherd lying on it (which did not ride along): the pan is looked at on the way
+    up from it, before standby and the shutter; the transfer then only reaches back (a look
+    from standby during it and back cost 2.4 s, heap_20 seed 45)."""
+    world = World(
+        config,
+        [Sherd("a", 0.10, 0.22), Sherd("b", 0.13, 0.22, mass=0.005, support=0.01)],
+    )
+    outcome, _batch, rec = run_batch(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
+    scale = config.stations["scale"]
+    survey_z = scale.surface_z + config["survey"]["z"]
+    sx, sy = scale.place_at
+    looks = [
+        i
+        for i, m in enumerate(world.moves)
+        if m[2] == pytest.approx(survey_z) and abs(m[0] - sx) + abs(m[1] - sy) < 0.15
+    ]
+    standby = tuple(config["arm"]["standby"])
+    first_standby = next(i for i, m in enumerate(world.moves) if m[:2] == pytest.approx(standby))
+    assert looks and looks[0] < first_standby, (looks, first_standby)
+    assert not any(m[2] == pytest.approx(survey_z) for m in world.transfer_moves[0])
+    assert all(at[:2] == pytest.approx(standby) for at in world.at_shutter)
