@@ -57,6 +57,21 @@ class Sherd:
         return self.width if self.held_width is None else self.held_width
 
 
+def riding_world(config) -> "World":
+    """b (5 g) lies on a's edge and rides along on a's first grasp (World.doubles): 25 g, within
+    what one 50 x 40 mm sherd with a 7 mm wall can weigh; c lies apart."""
+    world = World(
+        config,
+        [
+            Sherd("a", 0.10, 0.22),
+            Sherd("b", 0.13, 0.22, mass=0.005, support=0.01),
+            Sherd("c", 0.25, 0.30),
+        ],
+    )
+    world.doubles = {"a": "b"}
+    return world
+
+
 class World:
     def __init__(self, config, sherds: List[Sherd]):
         self.config = config

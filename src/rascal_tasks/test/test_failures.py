@@ -445,15 +445,7 @@ def test_a_light_sherd_riding_on_a_neighbour_is_seen_on_the_scale_and_put_back(c
     # sherd with a 7 mm wall can weigh (35 g), so the mass alone cannot tell. a was picked with
     # a sherd lying on it, so the wrist camera looks at the pan while it settles: two sherds
     # there, put back apart, a row each (heap_mixed_20 seed 51: 10 g on 29 g, one row, exit 0)
-    world = World(
-        config,
-        [
-            Sherd("a", 0.10, 0.22),
-            Sherd("b", 0.13, 0.22, mass=0.005, support=0.01),
-            Sherd("c", 0.25, 0.30),
-        ],
-    )
-    world.doubles = {"a": "b"}
+    world = fake_rig.riding_world(config)
     looked, detect = [], fake_rig._Perception.detect
 
     def logging_detect(self, station):
