@@ -20,6 +20,7 @@ from rascal_tasks.failures import LOSE_SHERD, STOP, SherdFailure, classify
 from rascal_tasks.pickup import miss_spot
 from rascal_tasks.rig import Leftover, Observation, RigError
 from rascal_tasks.run_batch import what_is_left
+from rascal_tasks.selection import among_others
 from rascal_tasks.singulation import topple_direction, was_pushed
 from rascal_tasks.stations import DiscardStation
 from rascal_tasks.survey import describe_leftover
@@ -463,6 +464,21 @@ def test_a_light_sherd_riding_on_a_neighbour_is_seen_on_the_scale_and_put_back(c
     assert any("put back apart" in n for n in notes), notes
     assert "scale" in looked
     assert all(s.station == "discard" for s in world.sherds)
+
+
+def test_a_sherd_picked_where_two_were_put_back_is_looked_at_and_flagged_if_still_two(config):
+    # two put back together may lie as one outline (heap_20 seed 46): a sherd picked within its
+    # length of that spot is looked at on the scale; two seen after stations.LOOK_PUT_BACKS put
+    # backs are recorded as weighed, flagged, and the batch ends incomplete (a person must look)
+    o = Observation(0.20, 0.30, 0.0, 0.05, 0.04, 0.01, 0.20, 0.30, 0.005, 0.0, 0.06)
+    assert not among_others(o, [o])
+    assert among_others(o, [o], [(0.23, 0.31)])
+    assert not among_others(o, [o], [(0.30, 0.31)])
+    world = fake_rig.riding_world(config)
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished" and batch.put_back_at  # the first put back's spots
+    batch.two_seen.append(1)
+    assert "1 sherd recorded with a second sherd seen on the scale" in what_is_left(batch, [])
 
 
 def test_a_sherd_picked_alone_is_not_looked_at_on_the_scale(config, monkeypatch):

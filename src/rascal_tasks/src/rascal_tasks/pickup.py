@@ -57,7 +57,7 @@ class Pickup(BatchState):
                 b.sherd.taken_over(o, b.pickup)
             else:
                 b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
-            b.sherd.among_others = among_others(o, b.seen + b.leftovers)
+            b.sherd.among_others = among_others(o, b.seen + b.leftovers, b.put_back_at)
             return "held"
         attempts = b.config["recovery"]["max_grasp_attempts"]
         others, b.pending = b.pending, []  # the area changed under us: survey again

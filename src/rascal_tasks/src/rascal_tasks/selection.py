@@ -31,14 +31,19 @@ def same_size(a, b) -> bool:
     ) <= SAME_SIZE * max(b.width, 0.5 * b.length)
 
 
-def among_others(o: Observation, seen: list) -> bool:
+def among_others(o: Observation, seen: list, put_back_at=()) -> bool:
     """Whether a second sherd may have come up with `o`, just picked, by what the survey saw
     (`seen`: Observations and Leftovers): one lying on it (its outline partly covered, or one
     resting on something, `support`, within reach of its outline), or no grasp whose fingers
-    clear its neighbours. A light one lying on it rides along within the mass bound (10 g on
-    29 g, heap_mixed_20 seed 51). A neighbour merely beside it is not: looking after every sherd
-    within 10 mm of one took 17 looks in 20 sherds of heap_20 seed 45, none seeing two."""
+    clear its neighbours; or it lay within its length of where two sherds were put back
+    (`put_back_at`: set down together they may lie as one outline, and the next grasp took
+    both again, heap_20 seed 46). A light one lying on it rides along within the mass bound
+    (10 g on 29 g, heap_mixed_20 seed 51). A neighbour merely beside it is not: looking after
+    every sherd within 10 mm of one took 17 looks in 20 sherds of heap_20 seed 45, none seeing
+    two."""
     if o.covered > 0.0 or not o.grasp_clear:
+        return True
+    if any(o.distance_to(x, y) < o.length for x, y in put_back_at):
         return True
     return any(
         getattr(p, "support", 0.0) > STACKED and o.distance_to(p.x, p.y) < (o.length + p.length) / 2

@@ -248,6 +248,7 @@ class PutBack(BatchState):
                 spot = self._spot_beside(spots)
                 if self._set_down(*spot, top):
                     spots.append(spot)
+        b.put_back_at.extend(spots)  # a sherd picked there is looked at on the scale
         where = ", ".join("(%.3f, %.3f) m" % p for p in spots)
         text = "two sherds in one grasp: %s; this number goes to the next sherd picked" % (
             "put back apart at %s" % where if spots else "they fell on the way back to the mat"

@@ -29,6 +29,9 @@ MIN_SHERD_MASS = 0.001  # kg
 DENSEST_WARE = 2300.0  # kg/m^3
 CURVED_SURFACE = 1.1
 SCALE_POLL = 0.05  # s (rig clock) between looks at the scale's readings
+# Two sherds the wrist camera sees on the scale are put back apart this often for one row
+# (the mass bound's put back counts too); then recorded, flagged for a person.
+LOOK_PUT_BACKS = 2
 _STAMP_SLACK = 1e-3  # s: readings 10 Hz apart stamped a little early or late still cover
 
 
@@ -449,28 +452,34 @@ class ScaleStation(StationPlugin):
 
     def while_lifting(self, sherd):
         """With the camera over the scale: the look for a second sherd on the way up from it,
-        before the arm goes to standby for the photo (from standby and back cost 2.4 s a look
-        against 0.6 s with the stations apart: heap_20 seed 45, one station)."""
+        before the arm goes to standby for the photo, not from standby during the transfer
+        (the photo then never shows the arm, and the transfer only reaches back). Either way a
+        look cost 2.4-3.1 s there (heap_20 seeds 45, 46, 39), against 0.6 s with the stations
+        apart, where it overlaps the pan's settling."""
         if sherd.among_others:
             self._early_look = (sherd.seq, self._looked_at(sherd, back_to_hover=False))
 
     def _looked_at(self, sherd, back_to_hover: bool) -> Optional[str]:
         """A sherd picked from among others (SherdRecord.among_others) is looked at on the pan
         while it settles: "double" when the wrist camera sees two sherds there (`_two_on_pan`;
-        put back once: PutBack), else None, the arm back above the sherd (`back_to_hover`,
-        where the repick's descent starts) and the pan left to settle. A sherd seen as two
-        again after it was put back is one sherd, flagged."""
+        put back LOOK_PUT_BACKS times at most: PutBack), else None, the arm back above the
+        sherd (`back_to_hover`, where the repick's descent starts) and the pan left to settle.
+        Seen as two again after that: recorded, flagged (`two_seen`), the batch incomplete."""
         b = self.batch
         if not sherd.among_others:
             return None
         two = self._two_on_pan(sherd)
-        if two and b.put_back_doubles.get(sherd.seq, 0) == 0:
-            b.put_back_doubles[sherd.seq] = 1
+        times = b.put_back_doubles.get(sherd.seq, 0)
+        if two and times < LOOK_PUT_BACKS:
+            b.put_back_doubles[sherd.seq] = times + 1
             b.event(sherd, "two_in_one", two)
             return "double"
-        if two:
+        if two:  # two outlines are no heavy sherd: recorded as weighed, and a person must look
+            b.two_seen.append(sherd.seq)
             b.event(sherd, "two_seen", two)
-            sherd.note("looked at on the scale: %s; put back once and seen alike again" % two)
+            sherd.note(
+                "looked at on the scale: %s; put back %d times and seen alike again" % (two, times)
+            )
         if back_to_hover:
             x, y = sherd.last_xy
             hover = self.station.surface_z + sherd.grasp_height + b.config["arm"]["approach_offset"]
@@ -539,8 +548,9 @@ class ScaleStation(StationPlugin):
         b = self.batch
         x, y = sherd.last_xy
         # the gripper kept turned as it set the sherd down (or by pi: the fingers are alike), so
-        # the look turns no wrist; facing away from the base only where neither is in reach (a
-        # look turned so cost 2.4-2.6 s against 0.6 s unturned, heap_20 seeds 45, 46)
+        # the look turns no wrist; facing away from the base only where neither is in reach
+        # (with the camera over the scale a look costs 2.4-3.1 s either way, the climb to the
+        # survey height and back: heap_20 seeds 45, 46, 39, one station)
         z = self.station.surface_z + b.config["survey"]["z"]
         turned = (sherd.grasp_yaw, math.remainder(sherd.grasp_yaw + math.pi, 2.0 * math.pi))
         yaw = next(
