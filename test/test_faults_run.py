@@ -91,8 +91,23 @@ def assert_no_sherd_twice(recorded, truth, code):
 def test_second_run_on_the_rig_or_the_context_is_refused_naming_the_first(
     rig_factory, db, tmp_path
 ):
-    rig = rig_factory(archive=tmp_path / "archive")
+    # paced, and the other rig's master made ready first: the first run must still be running
+    # when the second is tried from there (as fast as it runs, the three sherds were recorded
+    # before that master had started, once in CI)
+    rig = rig_factory(archive=tmp_path / "archive", params={"/simulator/real_time_factor": 1.0})
     truth = ground_truth(rig)
+    other = RosMaster()
+    try:
+        other.run(["rosparam", "load", os.path.join(WORKSPACE, "config", "rascal.yaml")])
+        other.run(["rosparam", "set", "/rig/name", "sim-rig-2"])
+        _both_locks_refused(rig, other, db, truth)
+    finally:
+        other.stop()
+
+
+def _both_locks_refused(rig, other, db, truth):
+    """While a run records F-LOCK on `rig`: a second run on that rig is refused by the rig lock,
+    one from `other` (its own master) by the context lock; the first then finishes."""
     first = rascal(rig, "--dsn", db, "run", "--context", "F-LOCK")
     wait_until(lambda: rows(db, "F-LOCK"), 120, "the first run picking a sherd")
 
@@ -108,19 +123,13 @@ def test_second_run_on_the_rig_or_the_context_is_refused_naming_the_first(
     assert "F-LOCK-2" not in contexts(db)  # nothing written, nothing moved
 
     # the same context from another rig (its own master): the context lock
-    other = RosMaster()
-    try:
-        other.run(["rosparam", "load", os.path.join(WORKSPACE, "config", "rascal.yaml")])
-        other.run(["rosparam", "set", "/rig/name", "sim-rig-2"])
-        r = subprocess.run(
-            ["rosrun", "rascal_tasks", "rascal", "--dsn", db, "run", "--context", "F-LOCK"],
-            env=other.env,
-            capture_output=True,
-            text=True,
-            timeout=60,
-        )
-    finally:
-        other.stop()
+    r = subprocess.run(
+        ["rosrun", "rascal_tasks", "rascal", "--dsn", db, "run", "--context", "F-LOCK"],
+        env=other.env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert r.returncode == 4, r.stdout + r.stderr
     (line,) = error_lines(r.stderr)
     assert "context F-LOCK is being recorded by another `rascal run`" in line, line
