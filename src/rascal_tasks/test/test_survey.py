@@ -19,6 +19,7 @@ from rascal_tasks.survey import (
     describe_leftover,
     lawnmower,
     look_for,
+    reachable_look_yaws,
     seen_apart,
     taken_off_the_mat,
     view_over,
@@ -114,6 +115,20 @@ def test_the_look_at_a_far_corner_is_from_the_nearest_pose_the_arm_reaches(confi
     assert 0 < math.hypot(at[0] - x, at[1] - y) <= LOOK_BACK + 1e-9
     assert abs(math.atan2(at[1], at[0]) - math.atan2(y, x)) < 1e-9  # nearer the base, on its line
     assert view_over(B, 0.16, 0.25) == pytest.approx((0.16, 0.25))  # over it where it can
+
+
+def test_a_look_keeps_the_grasps_yaw_only_where_the_arm_reaches_it(config):
+    from rascal_tasks.wrist import same_grasp_yaws
+
+    z = config.stations["pickup"].surface_z + config["survey"]["z"]
+    out = math.atan2(0.233, 0.219)  # the gripper nearer the base than the camera it holds over
+    inward, outward = same_grasp_yaws(math.remainder(out + math.pi, 2.0 * math.pi))
+    assert outward == pytest.approx(out)
+    # near the base: every yaw, in the order asked
+    assert reachable_look_yaws(0.205, 0.219, z, (inward, outward, None)) == [inward, outward, None]
+    # farther out the gripper can no longer reach beyond the camera (turned towards the base)
+    assert reachable_look_yaws(0.219, 0.233, z, (inward, outward, None)) == [outward, None]
+    assert reachable_look_yaws(0.305, 0.325, z, (inward, outward, None)) == []
 
 
 def _seen(x, y, length=0.04):

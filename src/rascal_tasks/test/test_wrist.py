@@ -13,7 +13,14 @@ from fake_rig import Recorder, Sherd, World
 from rascal_tasks import workflow
 from rascal_tasks.config import config_from_dict
 from rascal_tasks.joint_motion import move_time, trapezoid
-from rascal_tasks.wrist import leg_time, route_yaw, standby_yaw, station_yaw, wrist_angle
+from rascal_tasks.wrist import (
+    leg_time,
+    route_yaw,
+    same_grasp_yaws,
+    standby_yaw,
+    station_yaw,
+    wrist_angle,
+)
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
@@ -38,6 +45,12 @@ def test_the_wrist_angle_is_the_waist_less_the_yaw_as_the_controller_solves_it()
     assert wrist_angle(0.28, -0.30, -0.89) == pytest.approx(0.07, abs=0.01)
     assert wrist_angle(0.02, -0.31, -0.89) == pytest.approx(-0.61, abs=0.01)
     assert -math.pi <= wrist_angle(-0.1, 0.001, -3.0) < math.pi
+
+
+def test_the_same_grasp_turned_by_pi_stays_within_the_wrists_range():
+    assert same_grasp_yaws(0.5) == pytest.approx((0.5, 0.5 - math.pi))
+    assert same_grasp_yaws(-3.0) == pytest.approx((-3.0, math.pi - 3.0))
+    assert all(-math.pi <= a <= math.pi for a in same_grasp_yaws(math.pi))
 
 
 def test_a_leg_takes_the_slower_of_the_waists_and_the_wrists_turn():

@@ -3,11 +3,9 @@ gripper, numbered. No ROS in here.
 """
 
 import dataclasses
-import math
 from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
-from rascal_tasks.config import top_down_reachable
 from rascal_tasks.manipulation import grasp_retrying, holdable, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
@@ -15,11 +13,11 @@ from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was
 from rascal_tasks.selection import among_others, covered, same_size
 from rascal_tasks.survey import (
     SAME_SHERD,
-    gripper_for_camera_over,
     lawnmower,
+    reachable_look_yaws,
     survey_at,
 )
-from rascal_tasks.wrist import route_yaw
+from rascal_tasks.wrist import route_yaw, same_grasp_yaws
 
 
 class Pickup(BatchState):
@@ -200,7 +198,7 @@ def both_views_diameter(a: Observation, b: Observation) -> dict:
 
 def look_from(b, o: Observation) -> Tuple[float, float, Optional[float]]:
     """Where the wrist camera looks at `o` from, (x, y, gripper yaw or None: facing away from
-    the base), the first the arm reaches at the survey height (config.top_down_reachable):
+    the base), the first the arm reaches at the survey height (survey.reachable_look_yaws):
     over it, the gripper turned as its grasp will be along the sherd's way (wrist.route_yaw;
     the fingers are alike turned by pi), so the move down to the grasp turns no wrist; over it,
     facing away from the base; else the survey's view nearest it, which saw it before (the far
@@ -208,10 +206,9 @@ def look_from(b, o: Observation) -> Tuple[float, float, Optional[float]]:
     z = b.pickup.surface_z + b.config["survey"]["z"]
     route = b.route()
     g = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
-    for yaw in (g, math.remainder(g + math.pi, 2.0 * math.pi), None):
-        ex, ey, _ = gripper_for_camera_over(o.x, o.y, yaw)
-        if top_down_reachable(ex, ey, z):
-            return o.x, o.y, yaw
+    reachable = reachable_look_yaws(o.x, o.y, z, same_grasp_yaws(g) + (None,))
+    if reachable:
+        return o.x, o.y, reachable[0]
     area = b.pickup.area
     views = lawnmower(area.center, area.size, b.config["survey"]["step"])
     x, y = min(views, key=lambda v: o.distance_to(*v))

@@ -90,12 +90,17 @@ class Place(BatchState):
             after.make_way(s)
             return "placed"
         if plugin.hover_after_place:  # where repick's grasp starts its descent (no move then)
-            hover = st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
-            b.move_down(*st.place_at, hover, yaw, linear=True)
+            b.move_down(*st.place_at, hover_z(b, st, s), yaw, linear=True)
         elif not plugin.release_from_above:
             b.move_down(*st.place_at, b.travel_z(), yaw, linear=True)
         s.placed(st, yaw)
         return "placed"
+
+
+def hover_z(b, st, s) -> float:
+    """Where the gripper waits above sherd `s` lying at station `st`: the repick's descent
+    starts here."""
+    return st.surface_z + s.grasp_height + b.config["arm"]["approach_offset"]
 
 
 def place_z(b, st, s) -> float:

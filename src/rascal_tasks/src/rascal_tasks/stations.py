@@ -8,14 +8,13 @@ No ROS here: plug-ins use the rig interfaces (`rig.py`) and write through the sh
 """
 
 import enum
-import math
 import os
 from typing import Callable, Dict, List, NamedTuple, Optional, Tuple, Type
 
 from rascal_tasks.archival import exposure
 from rascal_tasks.archival.exposure import Exposure
 from rascal_tasks.rig import RigError, ScaleReading
-from rascal_tasks.wrist import standby_yaw
+from rascal_tasks.wrist import same_grasp_yaws, standby_yaw
 
 STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
 # The smallest sherd worth recording: 2 x 2 cm, 4 mm wall at 1.8 g/cm^3 is about 2.9 g
@@ -481,9 +480,10 @@ class ScaleStation(StationPlugin):
                 "looked at on the scale: %s; put back %d times and seen alike again" % (two, times)
             )
         if back_to_hover:
+            from rascal_tasks.station_states import hover_z  # station_states imports this module
+
             x, y = sherd.last_xy
-            hover = self.station.surface_z + sherd.grasp_height + b.config["arm"]["approach_offset"]
-            b.move_down(x, y, hover, sherd.grasp_yaw, linear=True)
+            b.move_down(x, y, hover_z(b, self.station, sherd), sherd.grasp_yaw, linear=True)
         return None
 
     def _weigh(self, sherd, since: float) -> str:
@@ -542,8 +542,7 @@ class ScaleStation(StationPlugin):
         picked as: a sherd partly under another when picked shows whole on the pan (heap_20
         seed 45: 46 x 28 mm picked, 48 x 44 mm on the pan, one sherd, put back in vain)."""
         # imported here: survey -> batch imports this module
-        from rascal_tasks.config import top_down_reachable
-        from rascal_tasks.survey import gripper_for_camera_over, survey_at
+        from rascal_tasks.survey import reachable_look_yaws, survey_at
 
         b = self.batch
         x, y = sherd.last_xy
@@ -552,11 +551,7 @@ class ScaleStation(StationPlugin):
         # (with the camera over the scale a look costs 2.4-3.1 s either way, the climb to the
         # survey height and back: heap_20 seeds 45, 46, 39, one station)
         z = self.station.surface_z + b.config["survey"]["z"]
-        turned = (sherd.grasp_yaw, math.remainder(sherd.grasp_yaw + math.pi, 2.0 * math.pi))
-        yaw = next(
-            (a for a in turned if top_down_reachable(*gripper_for_camera_over(x, y, a)[:2], z)),
-            None,
-        )
+        yaw = next(iter(reachable_look_yaws(x, y, z, same_grasp_yaws(sherd.grasp_yaw))), None)
         radius = b.config["recovery"]["search_radius"]
         seen = [c for c in survey_at(b, self.station, x, y, yaw) if c.distance_to(x, y) < radius]
         b.log(

@@ -4,7 +4,7 @@ and the states SURVEY and SURVEY_NEXT. No ROS in here.
 
 import math
 from dataclasses import replace
-from typing import List, Optional, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 from rascal_workcell import urdf_model
 
@@ -57,6 +57,14 @@ def gripper_for_camera_over(x: float, y: float, yaw=None) -> Tuple[float, float,
     if yaw is None:
         yaw = math.atan2(y, x)
     return x - CAMERA_OFFSET * math.cos(yaw), y - CAMERA_OFFSET * math.sin(yaw), yaw
+
+
+def reachable_look_yaws(x: float, y: float, z: float, yaws: Sequence) -> List:
+    """Those of `yaws` (gripper yaws; None: facing away from the base) from which the wrist
+    camera looks straight down at (x, y) from height `z` within the arm's reach, in order."""
+    from rascal_tasks.config import top_down_reachable  # config imports this module
+
+    return [a for a in yaws if top_down_reachable(*gripper_for_camera_over(x, y, a)[:2], z)]
 
 
 def camera_over(b, station, x, y, yaw=None):

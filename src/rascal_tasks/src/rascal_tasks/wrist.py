@@ -26,6 +26,11 @@ def wrist_angle(x: float, y: float, yaw: float) -> float:
     return math.remainder(math.atan2(y, x) - yaw, 2.0 * math.pi)
 
 
+def same_grasp_yaws(yaw: float) -> Tuple[float, float]:
+    """`yaw` and the same grasp turned by pi (the fingers are alike), in [-pi, pi)."""
+    return yaw, math.remainder(yaw + math.pi, 2.0 * math.pi)
+
+
 def leg_time(a: Tuple[float, float, float], b: Tuple[float, float, float]) -> float:
     """Rough seconds of a move between two top-down poses (x, y, yaw): the slower of the
     waist's and the wrist's trapezoids (the shoulder and elbow move about alike on every
@@ -64,7 +69,7 @@ def route_yaw(config, start, grasp_xy, grasp_yaw: float, stations: Sequence) -> 
     order the sherd visits them) take the least time. The wrist cannot pass its +-pi stop, so
     a turn across it goes the long way round: that is counted."""
     best, best_time = grasp_yaw, math.inf
-    for g in (grasp_yaw, math.remainder(grasp_yaw + math.pi, 2.0 * math.pi)):
+    for g in same_grasp_yaws(grasp_yaw):
         here = (grasp_xy[0], grasp_xy[1], g)
         total = leg_time(start, here) if start is not None else 0.0
         for st in stations:
