@@ -51,6 +51,9 @@ class Sherd:
     # the fingers close on it this wide (a chord across longer than its width seen from above:
     # a grasp turned to clear neighbours); None: its width
     held_width: Optional[float] = None
+    # a sherd under it that the wrist camera sees as part of it (one outline from above) lifts
+    # the wall the depth measures by this much, until it is set down elsewhere
+    lifted_wall: float = 0.0
 
     @property
     def chord(self) -> float:
@@ -138,7 +141,7 @@ class World:
     def put(self, s: Sherd, x, y):
         st = self.station_at(x, y)
         s.x, s.y, s.station = x, y, st.name if st else None
-        s.support = 0.0
+        s.support = s.lifted_wall = 0.0
         if s.stands_when_set_down and st is not None and st.name != "pickup":
             s.standing, s.stands_when_set_down = True, False
 
@@ -351,7 +354,7 @@ class _Perception(rig.Perception):
                 surface + s.support + GRASP_ABOVE,
                 0.0,
                 s.width + 0.012,
-                thickness=s.thickness,
+                thickness=s.thickness + s.lifted_wall,
                 support=s.support,
             )
             for s in self._in_view(station)

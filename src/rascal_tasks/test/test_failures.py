@@ -481,6 +481,32 @@ def test_a_sherd_picked_where_two_were_put_back_is_looked_at_and_flagged_if_stil
     assert "1 sherd recorded with a second sherd seen on the scale" in what_is_left(batch, [])
 
 
+def test_a_wall_measured_on_a_hidden_sherd_is_measured_again_on_the_pan_or_not_recorded(config):
+    # a lies on a sherd the camera sees as part of it: its wall reads 20 mm too thick on the
+    # mat (heap_20 seed 59: walls of 18-35 mm recorded for 5-12 mm). Looked at on the pan
+    # (b lies on a neighbour beside it: among others), it is measured again there, alone;
+    # not looked at, its mass shows the wall is none, and the row keeps no wall
+    world = World(
+        config,
+        [
+            Sherd("a", 0.10, 0.22, lifted_wall=0.02),
+            Sherd("b", 0.13, 0.22, mass=0.005, support=0.01),
+        ],
+    )
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished"
+    assert recorder.sherds[1].size[2] == pytest.approx(0.007)
+    assert not any(n.startswith("wall_not_recorded") for n in recorder.sherds[1].notes)
+    assert [w for w in recorder.writes if w == ("dimensions", 1)] == [("dimensions", 1)] * 2
+    world = World(config, [Sherd("a", 0.10, 0.22, lifted_wall=0.02)])
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished"
+    assert recorder.sherds[1].size[:2] == pytest.approx((0.05, 0.04))
+    assert recorder.sherds[1].size[2] is None
+    (note,) = [n for n in recorder.sherds[1].notes if n.startswith("wall_not_recorded: ")]
+    assert "27.0 mm wall" in note and "20.0 g" in note
+
+
 def test_a_sherd_picked_alone_is_not_looked_at_on_the_scale(config, monkeypatch):
     # nothing lay on it (selection.among_others), even with a neighbour beside it: the scale
     # is not looked at, so a spread-out batch pays nothing for the check

@@ -4,6 +4,7 @@ from a reading that held within the readability for scale.stable_window on a pla
 after it settled (the tare checked); otherwise the sherd is read again and then recorded
 mass_unstable without a mass. Only a steady reading below the minimum means "not there"."""
 
+import dataclasses
 import math
 import os
 
@@ -168,6 +169,32 @@ def test_more_mass_than_one_sherd_of_its_size_can_have_is_two_sherds_put_back_on
     assert plugin.after_place(sherd) == "done"
     assert _row(recorder).mass == pytest.approx(2.3 * SHERD, abs=5e-5)
     assert [n for n in _row(recorder).notes if n.startswith("mass checked: two sherds")]
+
+
+def test_a_wall_thicker_than_its_mass_allows_is_taken_out_of_the_row_with_the_figure(station):
+    # measured in a heap where it lay on a sherd seen as part of it (heap_20 seed 59: 26.6 g,
+    # 47 x 37 mm recorded with a 35.1 mm wall): the row keeps no wall, the note the figure
+    plugin, sherd, scale, world, recorder, _ = station
+    heaped = rig.Observation(
+        0.1, 0.2, 0, 0.045, 0.035, 0.032, 0.1, 0.2, 0.01, 0, 0.05, thickness=0.030
+    )
+    sherd.record_dimensions(heaped)
+    assert _row(recorder).size[2] == pytest.approx(0.030)
+    plugin.before_place(sherd)
+    _place(world, scale)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).mass == pytest.approx(SHERD, abs=5e-5)
+    assert _row(recorder).size[:2] == pytest.approx((0.045, 0.035))
+    assert _row(recorder).size[2] is None
+    (note,) = _notes(recorder, "wall_not_recorded")
+    assert "30.0 mm wall" in note and "13.9 g" in note
+    # its own 6 mm wall at 13.9 g (1.47 g/cm^3 of its box) is one wall: kept
+    sherd.record_dimensions(dataclasses.replace(heaped, thickness=0.006))
+    plugin.before_place(sherd)
+    _place(world, scale)
+    assert plugin.after_place(sherd) == "done"
+    assert _row(recorder).size[2] == pytest.approx(0.006)
+    assert len(_notes(recorder, "wall_not_recorded")) == 1
 
 
 def test_a_pan_already_loaded_is_tared_over_and_the_row_says_so(station):

@@ -8,9 +8,11 @@ recorded, the row says why). `done` and `lost` both end in `_finish`, the one pl
 completed and lost sherds. No ROS here.
 """
 
+import dataclasses
 import math
 from typing import Optional, Tuple
 
+from rascal_tasks.mass_and_size import wall_heavier_than
 from rascal_tasks.rig import Observation, Timings
 from rascal_tasks.wrist import wrist_angle
 
@@ -23,6 +25,7 @@ class SherdRecord:
         self.seq = seq
         self.status = status  # catalogue status, as far as this run knows
         self.observation: Optional[Observation] = None  # its detection (for its likeness)
+        self._size: Optional[Observation] = None  # the detection its size was recorded from
         self.grasp_yaw = 0.0
         self.turn = 0.0  # of the next grasp (Observation.grasp_turn)
         self.grasp_height = 0.0  # ee height above the surface when closing
@@ -116,7 +119,13 @@ class SherdRecord:
         self.station_index = index
 
     # -- catalogue writes (each commits) ---------------------------------------------------------
+    @property
+    def size(self) -> Optional[Observation]:
+        """The detection its size was last recorded from (its pickup's until then)."""
+        return self._size or self.observation
+
     def record_dimensions(self, o: Observation):
+        self._size = o
         self.batch.recorder.dimensions(
             self.seq,
             o.length,
@@ -135,12 +144,32 @@ class SherdRecord:
             )
         self.batch.recorder.mass(self.seq, kg, True, seconds=self._stage())
         self.mass, self.status = kg, "weighed"
+        self._check_wall()
 
     def record_mass_by_difference(self, kg: float):
         """Weighed with a sherd that then stayed on the pan: its own mass is the difference
         (weighed or photographed still; the status stays)."""
         self.batch.recorder.mass_by_difference(self.seq, kg, self.mass)
         self.mass = kg
+        self._check_wall()
+
+    def measured_alone(self, o: Observation):
+        """Seen alone as `o` where it was set down on a station (the scale's look, stations.
+        ScaleStation): its size is recorded from there, not from where it lay among others (a
+        sherd partly under another is seen whole only now; its wall, on the flat pan, is not
+        lifted by what it lay on). The detection for its likeness stays the pickup's."""
+        self.record_dimensions(o)
+        if self.mass is not None:
+            self._check_wall()
+
+    def _check_wall(self):
+        """A recorded wall that its mass says cannot be one wall (mass_and_size.
+        wall_heavier_than) is taken back out of the row, the figure kept in a note."""
+        why = wall_heavier_than(self.size, self.mass)
+        if not why:
+            return
+        self.batch.event(self, "wall_not_recorded", why)  # the note keeps the figure
+        self.record_dimensions(dataclasses.replace(self.size, thickness=0.0))
 
     def record_mass_unstable(self, reason: str):
         """The scale gave no trustworthy mass: the row says why and has no mass."""

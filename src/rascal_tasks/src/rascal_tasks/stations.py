@@ -13,6 +13,7 @@ from typing import Callable, Dict, List, NamedTuple, Optional, Tuple, Type
 
 from rascal_tasks.archival import exposure
 from rascal_tasks.archival.exposure import Exposure
+from rascal_tasks.mass_and_size import more_than_one_sherd
 from rascal_tasks.rig import RigError, ScaleReading
 from rascal_tasks.wrist import same_grasp_yaws, standby_yaw
 
@@ -21,12 +22,6 @@ STATION_PLUGINS: Dict[str, Type["StationPlugin"]] = {}
 # (shared/facts/sherds_and_colour.md §2). A lighter steady reading means the sherd is not on the
 # scale; an unsteady one means nothing.
 MIN_SHERD_MASS = 0.001  # kg
-# The most one sherd of a measured size can weigh: its whole bounding box (an outline fills
-# 60-85 % of it) at the wall thickness, curved (up to ~10 % more surface), of the densest ware
-# (fired clay 1.5-2.3 g/cm^3, facts sherds_and_colour.md §2). More than that on the scale is
-# two sherds lifted as one (a heap): flagged, for a person to look.
-DENSEST_WARE = 2300.0  # kg/m^3
-CURVED_SURFACE = 1.1
 SCALE_POLL = 0.05  # s (rig clock) between looks at the scale's readings
 # Two sherds the wrist camera sees on the scale are put back apart this often for one row
 # (the mass bound's put back counts too); then recorded, flagged for a person.
@@ -467,7 +462,9 @@ class ScaleStation(StationPlugin):
         b = self.batch
         if not sherd.among_others:
             return None
-        two = self._two_on_pan(sherd)
+        two, seen = self._two_on_pan(sherd)
+        if len(seen) == 1:
+            sherd.measured_alone(seen[0])
         times = b.put_back_doubles.get(sherd.seq, 0)
         if two and times < LOOK_PUT_BACKS:
             b.put_back_doubles[sherd.seq] = times + 1
@@ -521,7 +518,7 @@ class ScaleStation(StationPlugin):
                 sherd, "scale_empty", "reads %.1f g, steady, after placing" % (reading.mass * 1000)
             )
             return "missing"
-        too_heavy = self._more_than_one_sherd(sherd, reading.mass)
+        too_heavy = more_than_one_sherd(sherd.size, reading.mass)
         if too_heavy and b.put_back_doubles.get(sherd.seq, 0) == 0:
             # two sherds lifted as one (a heap): no mass for this row; they are put back apart
             # (station_states.PutBack) and the sherd keeps its number for the next pick
@@ -534,13 +531,14 @@ class ScaleStation(StationPlugin):
             sherd.note("mass checked: %s; put back once and weighed alike again" % too_heavy)
         return "done"
 
-    def _two_on_pan(self, sherd) -> str:
+    def _two_on_pan(self, sherd) -> Tuple[str, list]:
         """Why the wrist camera's look at the pan shows two sherds where `sherd` was set down, or
-        "". For a sherd picked from among others (SherdRecord.among_others): a light sherd lying
-        on the one grasped rides along within the mass bound (heap_mixed_20 seed 51: 10 g on
-        29 g weighed as one row). Two detections, not one outline larger than the sherd was
-        picked as: a sherd partly under another when picked shows whole on the pan (heap_20
-        seed 45: 46 x 28 mm picked, 48 x 44 mm on the pan, one sherd, put back in vain)."""
+        "", and what it saw there. For a sherd picked from among others (SherdRecord.
+        among_others): a light sherd lying on the one grasped rides along within the mass bound
+        (heap_mixed_20 seed 51: 10 g on 29 g weighed as one row). Two detections, not one
+        outline larger than the sherd was picked as: a sherd partly under another when picked
+        shows whole on the pan (heap_20 seed 45: 46 x 28 mm picked, 48 x 44 mm on the pan, one
+        sherd, put back in vain)."""
         # imported here: survey -> batch imports this module
         from rascal_tasks.survey import reachable_look_yaws, survey_at
 
@@ -563,24 +561,8 @@ class ScaleStation(StationPlugin):
                 len(seen),
                 self.station.name,
                 ", ".join("%.0f x %.0f mm" % (c.length * 1000, c.width * 1000) for c in seen),
-            )
-        return ""
-
-    @staticmethod
-    def _more_than_one_sherd(sherd, kg: float) -> str:
-        """Why `kg` is more than one sherd of the size the wrist camera measured can weigh, or
-        "" (also when its wall was not measured)."""
-        o = sherd.observation
-        if o is None or o.thickness <= 0.0:
-            return ""
-        most = o.length * o.width * o.thickness * CURVED_SURFACE * DENSEST_WARE
-        if kg <= most:
-            return ""
-        return (
-            "two sherds in one grasp? %.1f g is more than one sherd of %.0f x %.0f mm with a "
-            "%.1f mm wall can weigh (%.1f g at most)"
-            % (kg * 1000, o.length * 1000, o.width * 1000, o.thickness * 1000, most * 1000)
-        )
+            ), seen
+        return "", seen
 
     def _mass_unstable(self, sherd, reason: str):
         """No trustworthy mass: recorded so (no mass value), and the sherd goes on."""
