@@ -89,6 +89,7 @@ class World:
         self.named: List[str] = []  # named poses gone to (park: "sleep")
         self.refuse = lambda x, y, z, yaw, linear: None
         self.slips: Dict[str, tuple] = {}  # sherd name -> where it falls when carried away
+        self.slips_again: Dict[str, int] = {}  # sherd name -> times more it falls there so
         # sherd name -> where it falls when it slips out while lifted ((x, y), or None: off
         # every station, on the table beside the mat)
         self.lift_slips: Dict[str, Optional[tuple]] = {}
@@ -264,7 +265,11 @@ class _Gripper(rig.Gripper):
             and math.hypot(x - self.w.grasped_at[0], y - self.w.grasped_at[1]) > 0.05
         ):
             self.w.held = None  # slipped out on the way
-            self.w.put(s, *self.w.slips.pop(s.name))
+            if self.w.slips_again.get(s.name, 0) > 0:
+                self.w.slips_again[s.name] -= 1
+                self.w.put(s, *self.w.slips[s.name])
+            else:
+                self.w.put(s, *self.w.slips.pop(s.name))
         return self.w.held is not None
 
     def width(self):

@@ -142,6 +142,37 @@ def test_a_sherd_dropped_back_on_the_mat_and_not_grasped_there_gives_its_number_
     assert any("goes to the next sherd picked" in n for n in rec.sherds[1].notes)
 
 
+def test_a_sherd_that_slips_out_as_often_as_allowed_gives_its_number_on_and_waits(config):
+    """a slips out on its way to the scale three times (recovery.max_searches + 1), back onto
+    the mat each time (heap_20 seed 60: grasped along its length amid its neighbours): it is
+    not lost, its number goes to the next sherd picked, it is taken after the others, and
+    every sherd is recorded once, with no row lost."""
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.slips["a"] = (0.11, 0.22)
+    world.slips_again["a"] = config["recovery"]["max_searches"]
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    assert batch.lost == 0 and batch.unpickable == []
+    assert rec.sherds[1].pickup_xy == pytest.approx((0.25, 0.30))  # b, before a
+    assert rec.sherds[2].pickup_xy == pytest.approx((0.11, 0.22))
+    assert any("goes to the next sherd picked" in n for n in rec.sherds[1].notes)
+    assert {s.station for s in world.sherds} == {"discard"}
+
+
+def test_a_sherd_that_slips_out_as_often_twice_over_is_left_for_a_person(config):
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
+    world.slips["a"] = (0.11, 0.22)
+    world.slips_again["a"] = 2 * config["recovery"]["max_searches"] + 1
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "lost"}
+    assert "not picked again" in rec.sherds[2].lost_reason
+    assert batch.unpickable == [pytest.approx((0.11, 0.22))]
+    assert [s.station for s in world.sherds] == ["pickup", "discard"]
+    assert "1 sherd left on the pickup mat (could not be picked up)" in what_is_left(batch, [])
+
+
 def test_misses_on_a_sherd_nudged_across_a_grid_line_count_at_one_spot():
     # heap seed 39: the fingers nudged a sherd lying across another by a fraction of a
     # millimetre between rounds; rounded to 1 cm it was at (0.08, 0.20), then (0.09, 0.20), and

@@ -77,6 +77,9 @@ class Batch:
         # the station the last move lowered the held sherd at, ready to let go (Translate)
         self.lowered_at = None
         self.unpickable: List[tuple] = []  # where sherds were left after repeated failures
+        # where unmeasured sherds lay that slipped out of the fingers on their way from the
+        # pickup mat as often as the recovery allows (recovery.Recover): taken after the others
+        self.slipped_from: List[tuple] = []
         self.lift_slips: List[Observation] = []  # grasped sherds that slipped out while lifted
         self.unchecked_slips: List[Observation] = []  # ... not yet looked for by a survey
         self.pushed = set()  # rounded (x, y) where a sherd was pushed apart (singulation.py)

@@ -5,6 +5,7 @@ No ROS in here.
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.rig import Observation
+from rascal_tasks.selection import SLIPPED_HERE
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.survey import survey_at, survey_pickup_area
 
@@ -37,10 +38,13 @@ class Recover(BatchState):
     def run(self):
         b = self.batch
         s = b.sherd
-        if s.drops > b.config["recovery"]["max_searches"]:
+        too_often = s.drops > b.config["recovery"]["max_searches"]
+        if too_often and s.station_index >= 0:
             return self.lose("dropped %d times" % s.drops)
         station, candidates, ref = self.search(s)
         like = s.observation
+        if too_often:
+            return self.too_often(s, station, candidates, ref)
         if not candidates and self.measured(s):
             return self.done_unseen(s)
         if not candidates:
@@ -76,6 +80,41 @@ class Recover(BatchState):
             s.seen(o, b.pickup)
             s.record_dimensions(o)
         return "held"
+
+    def too_often(self, s: SherdRecord, station, candidates, ref) -> str:
+        """`s`, not measured yet, slipped out of the fingers on its way from the pickup mat as
+        often as recovery.max_searches allows. Lying on the mat again, it is not lost (heap_20
+        seed 60: a sherd grasped along its length amid its neighbours was recorded lost twice,
+        three drops each, and then recorded under a third number): its number goes to the next
+        sherd picked, and it is taken after the others (selection.in_pick_order), whose going
+        may leave it a grasp that holds; slipping as often from there again, it is left for a
+        person. Not seen on the mat: lost."""
+        b = self.batch
+        if station is not b.pickup or not candidates:
+            return self.lose("dropped %d times" % s.drops)
+        c = min(
+            candidates, key=lambda c: unlikeness(c, s.observation.length, s.observation.width, ref)
+        )
+        again = any(c.distance_to(x, y) < SLIPPED_HERE for x, y in b.slipped_from)
+        b.slipped_from.append((c.x, c.y))
+        why = "dropped %d times on its way from the pickup mat" % s.drops
+        if again:
+            b.unpickable.append((c.x, c.y))
+            b.event(
+                None,
+                "unpickable",
+                "sherd at (%.3f, %.3f) m left in the pickup area: it slipped out of the fingers "
+                "%d times on its way, twice over; lay it apart from the others, or record it by "
+                "hand" % (c.x, c.y, s.drops),
+            )
+        b.event(
+            s,
+            "returned_to_mat",
+            "%s, it lies there again at (%.3f, %.3f) m; this number goes to the next sherd "
+            "picked%s" % (why, c.x, c.y, "" if again else ", that one is taken after the others"),
+        )
+        b.number_to_next_pick(s, "%s, not picked again" % why)
+        return "returned"
 
     def measured(self, s: SherdRecord) -> bool:
         """Whether every station after the last one done with `s` only lets it fall (the

@@ -16,6 +16,9 @@ COVERED = 0.05
 # slips more: such a sherd is taken after the others of its kind, by when its neighbours may be
 # gone (perception's candidates: 0, 15, 30, 45 and 90 degrees).
 TURNED = math.radians(20.0)
+# [m] a sherd seen this near where one slipped out of the fingers as often as the recovery
+# allows is that one (a drop scatters it by a centimetre or two: recovery.unlikeness)
+SLIPPED_HERE = 0.03
 # Two measurements of one sherd agree this well in length and width (one that fell may lie
 # tilted now).
 SAME_SIZE = 0.25
@@ -61,11 +64,14 @@ def turned(o: Observation) -> bool:
     return abs(o.grasp_turn) > TURNED
 
 
-def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
+def in_pick_order(found: List[Observation], policy: str, slipped_from=()) -> List[Observation]:
     """`found` in the order to pick it: sherds nothing lies on first (the top of a heap), the
-    least covered of the rest after them; of alike covered ones, those whose fingers clear the
-    neighbours (perception's grasp_clear) first, and of those the ones whose grasp closes across
-    their minor axis (not `turned`); then by `policy`:
+    least covered of the rest after them; of alike covered ones, those that did not slip out of
+    the fingers as often as the recovery allows (lying within SLIPPED_HERE of a spot of
+    `slipped_from`: taken after the others, whose going may leave it a grasp that holds; heap_20
+    seed 60 dropped one grasped along its length six times from amid its neighbours), then those
+    whose fingers clear the neighbours (perception's grasp_clear), and of those the ones whose
+    grasp closes across their minor axis (not `turned`); then by `policy`:
     - nearest: nearest the arm's base first (the shortest reach, the least time; the default);
     - largest: largest length x width first;
     - most_isolated: largest edge-to-edge gap to its nearest neighbour first.
@@ -83,6 +89,11 @@ def in_pick_order(found: List[Observation], policy: str) -> List[Observation]:
         ordered = sorted(found, key=lambda o: -gap(o))
     else:
         ordered = sorted(found, key=lambda o: math.hypot(o.x, o.y))
+
+    def slipped(o):
+        return any(o.distance_to(x, y) < SLIPPED_HERE for x, y in slipped_from)
+
     return sorted(
-        ordered, key=lambda o: (o.covered if covered(o) else 0.0, not o.grasp_clear, turned(o))
+        ordered,
+        key=lambda o: (o.covered if covered(o) else 0.0, slipped(o), not o.grasp_clear, turned(o)),
     )

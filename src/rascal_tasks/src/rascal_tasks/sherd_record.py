@@ -61,6 +61,7 @@ class SherdRecord:
         recorded afresh."""
         self.seen(o, station)
         self.picked_xy = (o.x, o.y)
+        self.drops = 0  # the recovery's bound is this sherd's (the row keeps every drop)
         self.batch.recorder.taken_over(self.seq, (o.x, o.y))
         self.record_dimensions(o)
 

@@ -357,7 +357,9 @@ class Survey(BatchState):
                 return "empty"
             return self.run()
         b.empty_surveys = 0
-        b.pending = in_pick_order(found, b.config["perception"]["selection_policy"])
+        b.pending = in_pick_order(
+            found, b.config["perception"]["selection_policy"], slipped_from=b.slipped_from
+        )
         b.pending_stale = False
         return "found"
 
