@@ -41,7 +41,7 @@ from typing import Callable, Dict, List, Tuple
 
 from rascal_tasks.config import Config
 from rascal_tasks.joint_motion import move_time
-from rascal_tasks.survey import gripper_for_camera_over, lawnmower, look_z
+from rascal_tasks.survey import gripper_for_camera_over, lawnmower
 
 # rascal_sim ScaleSensor (timing.md): first-order settling, readings every 0.1 s
 SCALE_TIME_CONSTANT = 0.3  # [s]
@@ -89,8 +89,7 @@ def sequence(cfg: Config, pickup_xy: Tuple[float, float], look: bool = True) -> 
     px, py = pickup_xy
     z0 = cfg.stations["pickup"].surface_z + GRASP_HEIGHT
     if look:
-        z = look_z(cfg, cfg.stations["pickup"])
-        steps += camera_over_steps(cfg, [pickup_xy], "look at the sherd", z)
+        steps += camera_over_steps(cfg, [pickup_xy], "look at the sherd")
     steps += [
         Step("approach pickup", (px, py, z0 + approach), wait=margin_stroke),  # open on the way
         Step("descend", (px, py, z0), wait=margin_stroke),  # close
@@ -157,15 +156,13 @@ def merged(steps: List[Step]) -> List[Step]:
     return out
 
 
-def camera_over_steps(cfg: Config, spots, what: str, z=None) -> List[Step]:
-    """The wrist camera over each of `spots` of the pickup area at the survey height (or
-    ee_gripper_link at `z`)."""
+def camera_over_steps(cfg: Config, spots, what: str) -> List[Step]:
+    """The wrist camera over each of `spots` of the pickup area at the survey height."""
     st, sv = cfg.stations["pickup"], cfg["survey"]
-    z = st.surface_z + sv["z"] if z is None else z
     out = []
     for x, y in spots:
         ex, ey, _ = gripper_for_camera_over(x, y)
-        out.append(Step(what, (ex, ey, z), wait=sv["settle_time"]))
+        out.append(Step(what, (ex, ey, st.surface_z + sv["z"]), wait=sv["settle_time"]))
     return out
 
 

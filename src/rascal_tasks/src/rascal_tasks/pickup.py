@@ -14,7 +14,6 @@ from rascal_tasks.selection import among_others, covered, same_size
 from rascal_tasks.survey import (
     SAME_SHERD,
     lawnmower,
-    look_z,
     reachable_look_yaws,
     survey_at,
 )
@@ -197,20 +196,20 @@ def both_views_diameter(a: Observation, b: Observation) -> dict:
     return {"vessel_diameter": diameter, "vessel_diameter_sigma": diameter**2 * sigma_k / 2.0}
 
 
-def look_from(b, o: Observation) -> Tuple[float, float, Optional[float], float]:
+def look_from(b, o: Observation) -> Tuple[float, float, Optional[float]]:
     """Where the wrist camera looks at `o` from, (x, y, gripper yaw or None: facing away from
-    the base, ee_gripper_link's height), the first the arm reaches (survey.reachable_look_yaws)
-    at the height of a look at one sherd (survey.look_z): over it, the gripper turned as its
-    grasp will be along the sherd's way (wrist.route_yaw; the fingers are alike turned by pi),
-    so the move down to the grasp turns no wrist; over it, facing away from the base; else the
-    survey's view nearest it, at the survey's height, which saw it before."""
-    z = look_z(b.config, b.pickup)
+    the base), the first the arm reaches at the survey height (survey.reachable_look_yaws):
+    over it, the gripper turned as its grasp will be along the sherd's way (wrist.route_yaw;
+    the fingers are alike turned by pi), so the move down to the grasp turns no wrist; over it,
+    facing away from the base; else the survey's view nearest it, which saw it before (the far
+    corners of the mat are out of reach at the survey height)."""
+    z = b.pickup.surface_z + b.config["survey"]["z"]
     route = b.route()
     g = route_yaw(b.config, b.last_pose, (o.grasp_x, o.grasp_y), o.grasp_yaw, route)
     reachable = reachable_look_yaws(o.x, o.y, z, same_grasp_yaws(g) + (None,))
     if reachable:
-        return o.x, o.y, reachable[0], z
+        return o.x, o.y, reachable[0]
     area = b.pickup.area
     views = lawnmower(area.center, area.size, b.config["survey"]["step"])
     x, y = min(views, key=lambda v: o.distance_to(*v))
-    return x, y, None, b.pickup.surface_z + b.config["survey"]["z"]
+    return x, y, None

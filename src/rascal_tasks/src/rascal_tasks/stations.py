@@ -540,18 +540,18 @@ class ScaleStation(StationPlugin):
         shows whole on the pan (heap_20 seed 45: 46 x 28 mm picked, 48 x 44 mm on the pan, one
         sherd, put back in vain)."""
         # imported here: survey -> batch imports this module
-        from rascal_tasks.survey import look_z, reachable_look_yaws, survey_at
+        from rascal_tasks.survey import reachable_look_yaws, survey_at
 
         b = self.batch
         x, y = sherd.last_xy
         # the gripper kept turned as it set the sherd down (or by pi: the fingers are alike), so
-        # the look turns no wrist; facing away from the base only where neither is in reach.
-        # From a look's height, not the survey's: the climb to the survey height and back was
-        # most of a look's 2.4-3.1 s with the camera over the scale (heap_20 seeds 45, 46, 39)
-        z = look_z(b.config, self.station)
+        # the look turns no wrist; facing away from the base only where neither is in reach
+        # (with the camera over the scale a look costs 2.4-3.1 s either way, the climb to the
+        # survey height and back: heap_20 seeds 45, 46, 39, one station)
+        z = self.station.surface_z + b.config["survey"]["z"]
         yaw = next(iter(reachable_look_yaws(x, y, z, same_grasp_yaws(sherd.grasp_yaw))), None)
         radius = b.config["recovery"]["search_radius"]
-        seen = [c for c in survey_at(b, self.station, x, y, yaw, z) if c.distance_to(x, y) < radius]
+        seen = [c for c in survey_at(b, self.station, x, y, yaw) if c.distance_to(x, y) < radius]
         b.log(
             "sherd %d, picked from among others: the %s looked at, %d seen"
             % (sherd.seq, self.station.name, len(seen))

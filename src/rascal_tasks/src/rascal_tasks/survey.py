@@ -24,13 +24,6 @@ SEEN_APART = 0.75
 # Looks of their own at sherds the image border cut in every survey view (one across the mat's
 # edge): each costs a move there (about 1 s), and a batch meets a few such sherds at most.
 MAX_EXTRA_LOOKS = 3
-# [m] How high a look at one sherd is made (ee_gripper_link above the station's surface; the
-# wrist camera sits 54 mm higher, URDF): below the survey's height, whose views must cover the
-# mat, so the climb to it and the way down to the grasp are shorter. The camera stays above the
-# D435's min-Z at 640 x 480 (175 mm, facts/widowx250_d435.md §4.2, unverified) over a
-# three-layer heap's top (~35 mm) with a centimetre to spare; its view there (55 x 42 deg:
-# 0.23 x 0.17 m) still holds recovery.search_radius around the sherd, and the pan.
-LOOK_Z = 0.17
 # How much nearer the base than a cut sherd the camera may look from when it cannot be over it
 # at the survey height (the mat's far corners): the sherd then lies off the image's centre, by
 # less than the view's half-height (~0.11 m) less half the longest sherd.
@@ -74,22 +67,16 @@ def reachable_look_yaws(x: float, y: float, z: float, yaws: Sequence) -> List:
     return [a for a in yaws if top_down_reachable(*gripper_for_camera_over(x, y, a)[:2], z)]
 
 
-def look_z(config, station) -> float:
-    """ee_gripper_link's height for a look at one sherd on `station` (LOOK_Z), never above the
-    survey's."""
-    return station.surface_z + min(LOOK_Z, config["survey"]["z"])
-
-
-def camera_over(b, station, x, y, yaw=None, z=None):
-    """Put the wrist camera over (x, y) of a station, at the survey height (or `z`)."""
+def camera_over(b, station, x, y, yaw=None):
+    """Put the wrist camera over (x, y) of a station, at the survey height."""
     ex, ey, yaw = gripper_for_camera_over(x, y, yaw)
-    b.move_down(ex, ey, station.surface_z + b.config["survey"]["z"] if z is None else z, yaw)
+    b.move_down(ex, ey, station.surface_z + b.config["survey"]["z"], yaw)
 
 
-def survey_at(b, station, x, y, yaw=None, z=None) -> List[Observation]:
-    """Put the wrist camera over (x, y) of a station (`yaw`: gripper_for_camera_over; `z`:
-    ee_gripper_link's height, the survey's unless given) and detect what is there."""
-    camera_over(b, station, x, y, yaw, z)
+def survey_at(b, station, x, y, yaw=None) -> List[Observation]:
+    """Put the wrist camera over (x, y) of a station (`yaw`: gripper_for_camera_over) and
+    detect what is there."""
+    camera_over(b, station, x, y, yaw)
     with b.phase("perception"):
         b.rig.clock.sleep(b.config["survey"]["settle_time"])
         return b.rig.perception.detect(station.name)
