@@ -163,7 +163,9 @@ bool SherdMeasurer::measure(const Blob& blob, const cv::Mat& rgb, const cv::Mat&
     top.at<uint8_t>(static_cast<int>((p.y - lo.y) / kCell) + pad, static_cast<int>((p.x - lo.x) / kCell) + pad) = 255;
   }
   const double range0 = n.dot(view.base_T_camera.translation()) + plane.w() - out.height;
-  const int gap = std::max(3, static_cast<int>(std::ceil(2.0 * range0 / k.fx * 1000.0 / kCell)) | 1);
+  // two pixels' footprint on the plane, and never under 5 cells: at 3 a close view's pixels (1.4 cells
+  // apart at 0.22 m) left gaps the 3 x 3 cross did not fill, and no sample counted as interior
+  const int gap = std::max(5, static_cast<int>(std::ceil(2.0 * range0 / k.fx * 1000.0 / kCell)) | 1);
   cv::morphologyEx(top, top, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(gap, gap)));
   if (out.depth_valid) {
     // The shell fit takes only the top face: a sherd's side wall, seen obliquely away from the
