@@ -54,6 +54,8 @@ class Sherd:
     # a sherd under it that the wrist camera sees as part of it (one outline from above) lifts
     # the wall the depth measures by this much, until it is set down elsewhere
     lifted_wall: float = 0.0
+    # perception's grasp turned this far off across its minor axis (neighbours in the way)
+    grasp_turn: float = 0.0
 
     @property
     def chord(self) -> float:
@@ -357,7 +359,7 @@ class _Perception(rig.Perception):
                 s.x,
                 s.y,
                 surface + s.support + GRASP_ABOVE,
-                0.0,
+                s.grasp_turn,
                 s.width + 0.012,
                 thickness=s.thickness + s.lifted_wall,
                 support=s.support,
