@@ -54,8 +54,6 @@ class Sherd:
     # a sherd under it that the wrist camera sees as part of it (one outline from above) lifts
     # the wall the depth measures by this much, until it is set down elsewhere
     lifted_wall: float = 0.0
-    # perception's grasp turned this far off across its minor axis (neighbours in the way)
-    grasp_turn: float = 0.0
 
     @property
     def chord(self) -> float:
@@ -359,7 +357,7 @@ class _Perception(rig.Perception):
                 s.x,
                 s.y,
                 surface + s.support + GRASP_ABOVE,
-                s.grasp_turn,
+                0.0,
                 s.width + 0.012,
                 thickness=s.thickness + s.lifted_wall,
                 support=s.support,

@@ -173,31 +173,6 @@ def test_a_sherd_that_slips_out_as_often_twice_over_is_left_for_a_person(config)
     assert "1 sherd left on the pickup mat (could not be picked up)" in what_is_left(batch, [])
 
 
-def test_a_sherd_whose_grasp_closes_on_its_ends_is_pushed_apart_first_once(config):
-    # perception could only clear a's neighbours by closing the fingers along its length
-    # (heap_20 seed 60: grasped so six times, dropped six times): a is pushed apart from them
-    # first and the mat surveyed again; still so after the push, it is grasped as it is
-    world = World(
-        config,
-        [Sherd("a", 0.10, 0.22, length=0.06, width=0.035, grasp_turn=math.pi / 2)],
-    )
-    outcome, batch, rec = _run(config, world)
-    assert outcome == "finished" and rec.status() == {1: "done"}
-    ((_, pushed),) = batch.pushed_to
-    assert abs(pushed.grasp_turn) == pytest.approx(math.pi / 2)
-    assert len(world.closes) >= 2  # the push's closed fingers, then the grasp after it
-    # across its minor axis, or nearly: no push
-    world = World(config, [Sherd("a", 0.10, 0.22, length=0.06, width=0.035, grasp_turn=0.5)])
-    outcome, batch, rec = _run(config, world)
-    assert outcome == "finished" and rec.status() == {1: "done"} and batch.pushed_to == []
-    # as wide as long: no ends to close on
-    world = World(
-        config, [Sherd("a", 0.10, 0.22, length=0.05, width=0.045, grasp_turn=math.pi / 2)]
-    )
-    outcome, batch, rec = _run(config, world)
-    assert outcome == "finished" and rec.status() == {1: "done"} and batch.pushed_to == []
-
-
 def test_misses_on_a_sherd_nudged_across_a_grid_line_count_at_one_spot():
     # heap seed 39: the fingers nudged a sherd lying across another by a fraction of a
     # millimetre between rounds; rounded to 1 cm it was at (0.08, 0.20), then (0.09, 0.20), and

@@ -10,7 +10,7 @@ from rascal_tasks.manipulation import grasp_retrying, holdable, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
-from rascal_tasks.selection import among_others, covered, endwise, same_size
+from rascal_tasks.selection import among_others, covered, same_size
 from rascal_tasks.survey import (
     SAME_SHERD,
     lawnmower,
@@ -44,9 +44,6 @@ class Pickup(BatchState):
         b.pending_stale = True
         if too_short_to_hold(b, o):
             return self.left_unheld(o)
-        if endwise(o) and self.singulate(o, b.pending, miss_spot(b, o), ENDWISE_WHY):
-            b.pending = []  # the area changed: survey again
-            return "missed"
         slips = len(b.lift_slips)
         o, tries, held = grasp_retrying(b, o, b.pickup, taken_for=surveyed)
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
@@ -64,8 +61,7 @@ class Pickup(BatchState):
         others, b.pending = b.pending, []  # the area changed under us: survey again
         key = miss_spot(b, o)
         b.misses[key] = b.misses.get(key, 0) + 1
-        failed = "after %d failed grasps" % (2 * attempts)
-        if b.misses[key] >= 2 and self.singulate(o, others, key, failed):
+        if b.misses[key] >= 2 and self.singulate(o, others, key):
             return "missed"
         if b.misses[key] >= 2:
             b.unpickable.append((o.x, o.y))
@@ -77,10 +73,10 @@ class Pickup(BatchState):
             )
         return "missed"
 
-    def singulate(self, o, others, key, why: str) -> bool:
-        """Push it apart from its neighbours (failed twice here, or its only grasp closes on its
-        ends: `why`), once per spot and once per sherd (singulation.py), if the batch has pushes
-        left and a push keeps it on the mat. True when it was pushed."""
+    def singulate(self, o, others, key) -> bool:
+        """Failed twice here: push it apart from its neighbours, once per spot and once per sherd
+        (singulation.py), if the batch has pushes left and a push keeps it on the mat. True when
+        it was pushed."""
         b = self.batch
         if key in b.pushed or len(b.pushed) >= MAX_PUSHES or was_pushed(b, o):
             return False
@@ -92,8 +88,9 @@ class Pickup(BatchState):
         b.event(
             None,
             "pushed",
-            "sherd at (%.3f, %.3f) m pushed %.0f mm towards (%.2f, %.2f) %s, to part it from "
-            "its neighbours" % (o.x, o.y, PUSH * 1000, d[0], d[1], why),
+            "sherd at (%.3f, %.3f) m pushed %.0f mm towards (%.2f, %.2f) after %d failed "
+            "grasps, to part it from its neighbours"
+            % (o.x, o.y, PUSH * 1000, d[0], d[1], 2 * b.config["recovery"]["max_grasp_attempts"]),
         )
         return True
 
@@ -131,9 +128,6 @@ class Pickup(BatchState):
             "sherd at (%.3f, %.3f) m left in the pickup area: %s" % (o.x, o.y, failure.reason),
         )
         return "missed"
-
-
-ENDWISE_WHY = "before a grasp that would close on its ends (its neighbours block one across it)"
 
 
 def too_short_to_hold(b, o: Observation) -> bool:

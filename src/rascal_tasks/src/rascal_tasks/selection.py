@@ -19,12 +19,6 @@ TURNED = math.radians(20.0)
 # [m] a sherd seen this near where one slipped out of the fingers as often as the recovery
 # allows is that one (a drop scatters it by a centimetre or two: recovery.unlikeness)
 SLIPPED_HERE = 0.03
-# A grasp turned further than this off across the minor axis of a sherd narrower than
-# ELONGATED of its length closes on its two ends: held by its tips, it swings out of the
-# fingers (heap_20 seed 60: a 58 x 37 mm sherd grasped so six times, dropped six times). Such
-# a sherd is pushed apart from its neighbours first (pickup.Pickup, singulation.py), once.
-ENDWISE = math.radians(60.0)
-ELONGATED = 0.75
 # Two measurements of one sherd agree this well in length and width (one that fell may lie
 # tilted now).
 SAME_SIZE = 0.25
@@ -68,11 +62,6 @@ def covered(o: Observation) -> bool:
 def turned(o: Observation) -> bool:
     """Whether its grasp is turned off its minor axis (TURNED)."""
     return abs(o.grasp_turn) > TURNED
-
-
-def endwise(o: Observation) -> bool:
-    """Whether `o`'s grasp closes on its ends (ENDWISE, ELONGATED)."""
-    return abs(o.grasp_turn) > ENDWISE and o.width < ELONGATED * o.length
 
 
 def in_pick_order(found: List[Observation], policy: str, slipped_from=()) -> List[Observation]:
