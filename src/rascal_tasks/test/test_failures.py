@@ -505,6 +505,11 @@ def test_a_sherd_picked_where_two_were_put_back_is_looked_at_and_flagged_if_stil
     assert not among_others(o, [o])
     assert among_others(o, [o], [(0.23, 0.31)])
     assert not among_others(o, [o], [(0.30, 0.31)])
+    # lying on another itself, its own survey detection (seen again 5 mm off by a fresh look)
+    # is not a neighbour resting within reach (heap_20 seed 58 looked at 16 sherds of 20)
+    on_one = replace(o, x=0.205, support=0.006)
+    assert not among_others(o, [on_one])
+    assert among_others(o, [replace(on_one, x=0.24, length=0.03, width=0.02)])
     world = fake_rig.riding_world(config)
     outcome, batch, recorder = _run(config, world)
     assert outcome == "finished" and batch.put_back_at  # the first put back's spots

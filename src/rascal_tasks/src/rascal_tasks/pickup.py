@@ -10,13 +10,8 @@ from rascal_tasks.manipulation import grasp_retrying, holdable, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
-from rascal_tasks.selection import among_others, covered, same_size
-from rascal_tasks.survey import (
-    SAME_SHERD,
-    lawnmower,
-    reachable_look_yaws,
-    survey_at,
-)
+from rascal_tasks.selection import SAME_SHERD, among_others, covered, itself, same_size
+from rascal_tasks.survey import lawnmower, reachable_look_yaws, survey_at
 from rascal_tasks.wrist import route_yaw, same_grasp_yaws
 
 
@@ -170,7 +165,7 @@ def look_again(b, o: Observation) -> Optional[Observation]:
     if covered(c):
         b.log("the sherd at (%.3f, %.3f) m is covered now: surveying again" % (c.x, c.y))
         return None
-    if c.distance_to(o.x, o.y) <= SAME_SHERD and same_size(c, o):
+    if itself(c, o):
         return dataclasses.replace(c, **both_views_diameter(o, c))
     return c
 

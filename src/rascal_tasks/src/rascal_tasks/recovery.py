@@ -17,6 +17,11 @@ def unlikeness(c: Observation, length: float, width: float, ref) -> float:
     return c.distance_to(*ref) + 4 * (abs(c.length - length) + abs(c.width - width))
 
 
+def unlike(like: Observation, c: Observation, ref) -> float:
+    """How unlike detection `c` is the sherd seen as `like`, last seen at `ref` (unlikeness)."""
+    return unlikeness(c, like.length, like.width, ref)
+
+
 class Recover(BatchState):
     """A dropped sherd: look where it was last seen; then, if it was on its way from the pickup
     area, where it was picked up and over the whole pickup area (a grasp that slips while lifting
@@ -53,23 +58,14 @@ class Recover(BatchState):
                 % (s.where, ", nor in the pickup area" if s.station_index < 0 else "")
             )
 
-        def unlike(c, _last=None):
-            return unlikeness(c, like.length, like.width, ref)
+        def like_it(c, _last=None):
+            return unlike(like, c, ref)
 
-        o, tries, held = grasp_retrying(b, min(candidates, key=unlike), station, like=unlike)
+        o, tries, held = grasp_retrying(b, min(candidates, key=like_it), station, like=like_it)
         if not held:
             why = "found but could not be picked up (%d grasps)" % tries
             if station is b.pickup and s.station_index < 0:
-                text = (
-                    "dropped back onto the pickup mat, %s there; this number goes to the next "
-                    "sherd picked" % why
-                )
-                b.event(s, "returned_to_mat", text)
-                s.note(text)
-                b.number_to_next_pick(
-                    s, "dropped back onto the pickup mat, %s, not picked again" % why
-                )
-                return "returned"
+                return self.returned(s, "dropped back onto the pickup mat, %s" % why)
             return self.lose(why)
         b.event(
             s, "recovered", "picked up again at the %s, (%.3f, %.3f) m" % (station.name, o.x, o.y)
@@ -92,9 +88,7 @@ class Recover(BatchState):
         b = self.batch
         if station is not b.pickup or not candidates:
             return self.lose("dropped %d times" % s.drops)
-        c = min(
-            candidates, key=lambda c: unlikeness(c, s.observation.length, s.observation.width, ref)
-        )
+        c = min(candidates, key=lambda c: unlike(s.observation, c, ref))
         again = any(c.distance_to(x, y) < SLIPPED_HERE for x, y in b.slipped_from)
         b.slipped_from.append((c.x, c.y))
         why = "dropped %d times on its way from the pickup mat" % s.drops
@@ -107,13 +101,23 @@ class Recover(BatchState):
                 "%d times on its way, twice over; lay it apart from the others, or record it by "
                 "hand" % (c.x, c.y, s.drops),
             )
-        b.event(
+        return self.returned(
+            s,
+            why,
+            "it lies there again at (%.3f, %.3f) m%s"
+            % (c.x, c.y, "" if again else ", taken after the others"),
+        )
+
+    def returned(self, s: SherdRecord, why: str, where: str = "") -> str:
+        """`s`, not measured, lies among the bag's sherds on the pickup mat again (`why`, and
+        `where`, said on its row): its number goes to the next sherd picked."""
+        self.batch.event(
             s,
             "returned_to_mat",
-            "%s, it lies there again at (%.3f, %.3f) m; this number goes to the next sherd "
-            "picked%s" % (why, c.x, c.y, "" if again else ", that one is taken after the others"),
+            "%s%s; this number goes to the next sherd picked"
+            % (why, ", " + where if where else ""),
         )
-        b.number_to_next_pick(s, "%s, not picked again" % why)
+        self.batch.number_to_next_pick(s, "%s, not picked again" % why)
         return "returned"
 
     def measured(self, s: SherdRecord) -> bool:

@@ -10,14 +10,12 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.batch import PUSHED_OFF, SLIPPED_AWAY, BatchState, NotSeenAgain
 from rascal_tasks.rig import Leftover, Observation
-from rascal_tasks.selection import SAME_SIZE, covered, in_pick_order, same_size
+from rascal_tasks.selection import SAME_SHERD, SAME_SIZE, covered, in_pick_order, same_size
 from rascal_tasks.singulation import lay_flat
 
 # Wrist camera offset from ee_gripper_link when the gripper points down, along the gripper's
 # yaw direction (camera_link sits 0.055 m "above" gripper_link in the URDF).
 CAMERA_OFFSET = urdf_model.camera_offset()
-# Two detections closer than this are the same sherd seen from two survey poses.
-SAME_SHERD = 0.02
 # Sherds seen within half a blob's length of its centre, together this much of its length x
 # width: the blob was several sherds, seen apart now (seen_apart).
 SEEN_APART = 0.75
