@@ -129,6 +129,41 @@ TEST(GraspPlanner, TurnsARoundSherdClearOfItsNeighboursButNotAnElongatedOne) {
   EXPECT_NEAR(std::fabs(alone.grasp.linear().col(1).y()), 1.0, 1e-9);
 }
 
+TEST(GraspPlanner, MovesTheGraspAlongAnElongatedSherdPastNeighboursBesideItsMiddle) {
+  // 62 x 35 mm along x at (0.2, 0.25); 10 mm tall neighbours beside both long sides from its
+  // left end to 2 mm right of its middle. Across the middle, turned 15 or 30 degrees the fingers
+  // land on them; moved 45 % of the half-length to the right they close across its width, clear
+  const GraspPlanner planner(withGripper());
+  const CrowdedView crowd;
+  cv::Mat height = cv::Mat::zeros(crowd.height.size(), CV_32F);
+  const CameraIntrinsics& k = crowd.view.intrinsics;
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d p = crowd.view.base_T_camera * (0.3 * k.ray(u, v));
+      const double dx = p.x() - 0.2, dy = std::fabs(p.y() - 0.25);
+      if (dx >= -0.040 && dx <= 0.002 && dy >= 0.020 && dy <= 0.045) height.at<float>(v, u) = 0.010f;
+    }
+  }
+  GraspContext context;
+  context.height = &height;
+  context.view = &crowd.view;
+  SherdDetection s = sherd(0.2, 0.25, 0.0, 0.062, 0.035, 0.008);
+  planner.plan(s, &context);
+  EXPECT_TRUE(s.grasp_clear);
+  EXPECT_NEAR(std::fabs(s.grasp.linear().col(1).y()), 1.0, 1e-9);  // still closing across y
+  EXPECT_NEAR(s.grasp.translation().x(), 0.2 + 0.45 * 0.031, 1e-9);
+  EXPECT_NEAR(s.grasp.translation().y(), 0.25, 1e-9);
+  EXPECT_NEAR(s.grasp_width, 0.035 + 0.012, 1e-9);
+  // mirrored, it moves the other way
+  cv::Mat mirrored;
+  cv::flip(height, mirrored, 1);  // the camera's x is the table's x
+  context.height = &mirrored;
+  SherdDetection t = sherd(0.2, 0.25, 0.0, 0.062, 0.035, 0.008);
+  planner.plan(t, &context);
+  EXPECT_TRUE(t.grasp_clear);
+  EXPECT_LT(t.grasp.translation().x(), 0.2 - 0.01);
+}
+
 TEST(GraspPlanner, TurnsASherdTooNarrowToHoldAcrossItsMinorAxis) {
   // 31 mm across: the fingers would stop 1 mm short of shut (30 mm), which the gripper reads as
   // empty; turned 15 degrees they close on a 42 mm chord of the 47 x 31 mm outline

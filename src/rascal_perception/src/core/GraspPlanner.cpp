@@ -16,6 +16,31 @@ double segmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const
   return (a + t * ab - p).norm();
 }
 
+/// Across-extent [lo, hi] (along `across`, about `centre`) of the outline's part within `half_band`
+/// of `shift` along `along`: what two fingers that wide, centred there, close on. False when the
+/// band misses the outline.
+bool bandExtent(const std::vector<Eigen::Vector3d>& outline, const Eigen::Vector2d& centre,
+                const Eigen::Vector2d& along, const Eigen::Vector2d& across, double shift, double half_band,
+                double& lo, double& hi) {
+  lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  const double a0 = shift - half_band, a1 = shift + half_band;
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const Eigen::Vector2d p = outline[i].head<2>() - centre, q = outline[(i + 1) % outline.size()].head<2>() - centre;
+    double pa = along.dot(p), qa = along.dot(q), pt = across.dot(p), qt = across.dot(q);
+    if ((pa < a0 && qa < a0) || (pa > a1 && qa > a1)) continue;
+    // the edge clipped to the band
+    for (const double a : {a0, a1}) {
+      if ((pa - a) * (qa - a) < 0.0) {
+        const double t = pt + (qt - pt) * (a - pa) / (qa - pa);
+        lo = std::min(lo, t), hi = std::max(hi, t);
+      }
+    }
+    if (pa >= a0 && pa <= a1) lo = std::min(lo, pt), hi = std::max(hi, pt);
+    if (qa >= a0 && qa <= a1) lo = std::min(lo, qt), hi = std::max(hi, qt);
+  }
+  return hi > lo;
+}
+
 double outlineGap(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
   double best = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& p : a) {
@@ -52,20 +77,26 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
     };
     std::vector<Candidate> candidates;
     double chord0 = 0.0;  // across the minor axis
-    for (const double turn_deg : {0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 90.0}) {
-      const double y = s.yaw + turn_deg * M_PI / 180.0;
+    for (const Offer& offer : kOffers) {
+      const double y = s.yaw + offer.turn_deg * M_PI / 180.0;
       const Eigen::Vector2d across(-std::sin(y), std::cos(y));  // the fingers close along R*y
+      const Eigen::Vector2d along(std::cos(y), std::sin(y));
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (const Eigen::Vector3d& p : s.outline) {
-        const double t = across.dot(p.head<2>() - s.centre.head<2>());
-        lo = std::min(lo, t);
-        hi = std::max(hi, t);
+      const double shift = offer.shift * s.length / 2;
+      if (shift == 0.0) {
+        for (const Eigen::Vector3d& p : s.outline) {
+          const double t = across.dot(p.head<2>() - s.centre.head<2>());
+          lo = std::min(lo, t);
+          hi = std::max(hi, t);
+        }
+      } else if (!bandExtent(s.outline, s.centre.head<2>(), along, across, shift, kFingerWidth / 2, lo, hi)) {
+        continue;
       }
-      if (turn_deg == 0.0) chord0 = hi - lo;
+      if (offer.turn_deg == 0.0 && shift == 0.0) chord0 = hi - lo;
       const double need = hi - lo + config_.grasp_margin;
       if (need > maxOpening()) continue;
       const double open = std::clamp(need, minOpening(), maxOpening());
-      const Eigen::Vector2d c = s.centre.head<2>() + across * (lo + hi) / 2;
+      const Eigen::Vector2d c = s.centre.head<2>() + along * shift + across * (lo + hi) / 2;
       const double at = tipAtChordEnds(y, hi - lo, c, s.surface, tip, own, *context);
       candidates.push_back({y, open, fingerClearance(y, open, c, s.surface, at, *context), hi - lo, c, at});
     }
