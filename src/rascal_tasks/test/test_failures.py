@@ -630,27 +630,27 @@ def test_one_of_two_that_falls_back_onto_the_scale_on_the_way_is_fetched_too(con
     assert all(s.station == "discard" for s in world.sherds)
 
 
-@pytest.mark.parametrize("among_others", [True, False])
-def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(
-    config, monkeypatch, among_others
-):
+@pytest.mark.parametrize("case", ["alone", "seen on the pan", "not seen on the pan"])
+def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(config, monkeypatch, case):
     # taken from the top of a heap (lying 20 mm up on another), set down on the scale it lies
-    # on the pan. Picked from among others (something may have come up with it), the blind
-    # grasp at the height it was picked up at closes over it; the fingers go down and close
-    # again low over the pan, with no look between (a look and a second grasp cost ~5 s a
-    # station), and straight down from where they missed, not up to travel height first.
-    # Alone (nothing on it or near it stacked), it is taken up low at once. The next station's
-    # grasp is low at once
+    # on the pan. Picked from among others (something may have come up with it) and not seen
+    # alone on the pan, the blind grasp at the height it was picked up at closes over it; the
+    # fingers go down and close again low over the pan, with no look between (a look and a
+    # second grasp cost ~5 s a station), and straight down from where they missed, not up to
+    # travel height first. Alone (nothing on it or near it stacked), it is taken up low at
+    # once; seen alone by the scale's look, by that look's grasp. The next station's grasp is
+    # low at once
     import rascal_tasks.manipulation as manipulation
     import rascal_tasks.pickup as pickup
     import rascal_tasks.station_states as station_states
 
     grasps, looks, heights = [], [], []
     real, real_look = manipulation.grasp, station_states.survey_at
+    detect = fake_rig._Perception.detect
 
     def counted(b, o, station, **kw):
         held = real(b, o, station, **kw)
-        grasps.append((station.name, held))
+        grasps.append((station.name, held, round(o.grasp_z, 4)))
         heights.append(world.at[2])  # where the arm is after it: lifted, or left where it missed
         return held
 
@@ -658,20 +658,29 @@ def test_a_sherd_taken_off_another_is_picked_up_again_low_on_the_station(
         looks.append(station.name)
         return real_look(b, station, *xy)
 
+    def blind_on_the_pan(self, station):
+        return [] if station == "scale" else detect(self, station)
+
     monkeypatch.setattr(manipulation, "grasp", counted)
     monkeypatch.setattr(station_states, "grasp", counted)
     monkeypatch.setattr(station_states, "survey_at", look)
-    monkeypatch.setattr(pickup, "among_others", lambda *_: among_others)
+    monkeypatch.setattr(pickup, "among_others", lambda *_: case != "alone")
+    if case == "not seen on the pan":
+        monkeypatch.setattr(fake_rig._Perception, "detect", blind_on_the_pan)
     top = Sherd("top", 0.16, 0.25)
     top.support = 0.02
     world = World(config, [top])
     outcome, batch, rec = _run(config, world)
     assert outcome == "finished" and rec.status() == {1: "done"}
     first, *later = config.route()[:-1]  # set down at, and picked up again from (not the box)
-    missed = [(first, False)] if among_others else []
-    assert grasps == [("pickup", True)] + missed + [(n, True) for n in [first] + later]
+    assert [g[:2] for g in grasps] == [("pickup", True)] + (
+        [(first, False)] if case == "not seen on the pan" else []
+    ) + [(n, True) for n in [first] + later]
+    scale = config.stations[first].surface_z
+    if case == "seen on the pan":  # the look's grasp: the fake detector's, over the pan
+        assert grasps[1][2] == round(scale + fake_rig.GRASP_ABOVE, 4)
     travel = config["arm"]["travel_z"]
-    if among_others:
+    if case == "not seen on the pan":
         assert heights[1] < travel, heights
         del heights[1]
     assert all(h == travel for h in heights), heights

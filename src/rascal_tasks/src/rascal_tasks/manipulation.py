@@ -122,7 +122,16 @@ def placed_observation(b, s, station) -> Observation:
     within reach of it (not SherdRecord.among_others: nothing can have come up with it) lies
     lower on the station than it was grasped by what it lay on, and is taken up low at once
     (regrasp_z): that first close met nothing in 7 of 8 misses of a heap of 20 (heap_20 seed
-    60), a close and a reopen each."""
+    60), a close and a reopen each. One seen alone there (the scale's look,
+    SherdRecord.measured_alone) is taken up by that detection's grasp, as it lies (its wrist
+    turned as the gripper is: the fingers are alike), not where and as it was set down (heap_20
+    seed 60: 7 of the 8 blind closes on the pan that met nothing came after a look that saw
+    the sherd alone there)."""
+    if s.seen_set_down is not None:
+        o = s.seen_set_down
+        back = (o.grasp_yaw, o.grasp_yaw + math.pi)
+        yaw = min(back, key=lambda g: abs(math.remainder(g - s.grasp_yaw, 2.0 * math.pi)))
+        return dataclasses.replace(o, grasp_yaw=math.remainder(yaw, 2.0 * math.pi))
     x, y = s.last_xy
     z = station.surface_z + s.grasp_height
     if lifted_off_another(s):

@@ -36,6 +36,8 @@ class SherdRecord:
         self.picked_xy: Optional[tuple] = None  # where it was picked (None: unknown on resume)
         # picked from among others (selection.among_others): what reaches the scale is looked at
         self.among_others = False
+        # seen alone where it was set down (the scale's look: measured_alone): its take-up there
+        self.seen_set_down: Optional[Observation] = None
         self.drops = 0
         self.mass: Optional[float] = None
         self.bin: Optional[str] = None  # the sorting bin it goes into (stations.DiscardStation)
@@ -105,6 +107,7 @@ class SherdRecord:
         from rascal_tasks.manipulation import holdable  # manipulation -> survey -> here
 
         self.where, self.last_xy = station.name, tuple(station.place_at)
+        self.seen_set_down = None
         if self.observation is not None and not holdable(self.batch.config, self.observation.width):
             self.grasp_yaw, self.turn = yaw, 0.0
             return
@@ -158,7 +161,9 @@ class SherdRecord:
         """Seen alone as `o` where it was set down on a station (the scale's look, stations.
         ScaleStation): its size is recorded from there, not from where it lay among others (a
         sherd partly under another is seen whole only now; its wall, on the flat pan, is not
-        lifted by what it lay on). The detection for its likeness stays the pickup's."""
+        lifted by what it lay on). The detection for its likeness stays the pickup's; it is
+        taken up by this one's grasp (manipulation.placed_observation)."""
+        self.seen_set_down = o
         self.record_dimensions(o)
         if self.mass is not None:
             self._check_wall()
