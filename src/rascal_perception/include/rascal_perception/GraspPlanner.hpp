@@ -14,9 +14,9 @@
 // by 15, 30, 45 and 90 degrees (the opening follows the outline's extent across each), and
 // across the minor axis moved along the sherd by a quarter and by 45 % of its half-length (the
 // opening follows the outline's extent within the fingers' width there); the first clear one
-// whose chord the fingers can hold (holdableChord) is taken (grasp_clear unless its chord is much longer than the
-// minor axis's, kMaxChordRatio, while the minor axis itself could be held), else the clearest
-// holdable one, else the clearest (grasp_clear false).
+// whose chord the fingers can hold (holdableChord) is taken (grasp_clear unless its chord is
+// much longer than the minor axis's, kMaxChordRatio, while the minor axis itself could be held),
+// else the clearest holdable one, else the clearest (grasp_clear false).
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -48,10 +48,10 @@ class GraspPlanner {
   /// near-round sherd turns freely.
   static constexpr double kMaxChordRatio = 1.25;
   /// One grasp to try: turned off the minor axis, and moved along the sherd's major axis (a
-  /// fraction of its half-length). Moved, the fingers still close across the narrow way, on a
-  /// chord no longer than the minor axis's, with the sherd's mass off the grasp by the shift; a
-  /// neighbour beside the sherd's middle is missed so where a turn of 30 or 45 degrees would
-  /// close near its ends (heap_20 seed 58: three sherds of 20 turned 40-70 degrees, the model's
+  /// fraction of its half-length). Moved, the fingers still close across the narrow way (on a
+  /// chord no longer than the middle's, for a sherd narrowing to its ends), with the sherd's
+  /// mass off the grasp by the shift: a neighbour beside the sherd's middle is missed that way,
+  /// where a turn of 30 or 45 degrees would close near its ends (heap_20 seed 58: three sherds of 20 turned 40-70 degrees, the model's
   /// slip chance 0.26-0.32 each). Tried in this order, nearest the minor axis first.
   struct Offer {
     double turn_deg, shift;
