@@ -159,13 +159,15 @@ def lifted_off_another(s) -> bool:
 
 
 def grasp_where_set_down(b, s, station) -> bool:
-    """The blind grasp that picks up again the sherd in progress `s` where it was set down on
-    `station` (placed_observation): at the height it was picked up at, so that a sherd that
-    rode on it from a heap is taken off it and the one under it, left on the pan, is weighed
-    out of the row by difference. Closing on nothing there (it lay tilted on the heap and lies
-    lower now: 18-24 mm seen there, 6-11 mm on the pan, heap seed 36), the fingers go down and
-    close again low over the station (regrasp_z), with no look between; later stations then
-    grasp it there at once. A look and a second grasp after the miss cost ~5 s a station."""
+    """The grasp that picks up again the sherd in progress `s` where it was set down on
+    `station` (placed_observation: by the look's grasp where one saw it alone there, low at
+    once for one lifted_off_another, else blind): at the height it was picked up at, so that
+    a sherd that rode on it from a heap is taken off it and the one under it, left on the pan,
+    is weighed out of the row by difference. Closing on nothing there (it lay tilted on the
+    heap and lies lower now: 18-24 mm seen there, 6-11 mm on the pan, heap seed 36), the
+    fingers go down and close again low over the station (regrasp_z), with no look between;
+    later stations then grasp it there at once. A look and a second grasp after the miss cost
+    ~5 s a station."""
     o = placed_observation(b, s, station)
     if grasp(b, o, station, lift_on_miss=False):
         s.taken_up_at(o.grasp_z, station)  # (low already, for one lifted_off_another)
