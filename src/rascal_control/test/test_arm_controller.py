@@ -226,10 +226,14 @@ def test_joint_states_drive_fk_and_tf(ros_master, rosrun):
 @requires_sim
 class TestAgainstTheSimulator:
     @pytest.fixture
-    def rig(self, ros_master, rosrun, tmp_path):
+    def rig(self, request, ros_master, rosrun, tmp_path):
+        # as fast as it runs, unless the test samples a motion: then paced at real time (as
+        # fast, on a loaded machine, /joint_states can skip a whole part of a move)
+        paced = request.node.get_closest_marker("paced") is not None
         ros_master.run(["rosparam", "load", CONFIG])
         ros_master.run(["rosparam", "set", "/use_sim_time", "true"])
-        ros_master.run(["rosparam", "set", "/simulator/real_time_factor", "0.0"])
+        rtf = "1.0" if paced else "0.0"
+        ros_master.run(["rosparam", "set", "/simulator/real_time_factor", rtf])
         ros_master.run(["rosparam", "set", "/simulator/wrist_camera", "false"])
         self.logs = [tmp_path / "sim.log", tmp_path / "arm_controller.log"]
         rosrun("rascal_sim", "sim", stdout=open(self.logs[0], "w"))
@@ -256,10 +260,13 @@ class TestAgainstTheSimulator:
         print(out)
         assert out["samples"] > 20 and out["deviation"] < 0.002, out
 
+    @pytest.mark.paced
     def test_a_chain_goes_straight_up_and_down_and_cuts_the_corners_above_the_blend(self, rig):
+        # (as fast as it ran, under CI's load once no /joint_states came between the verticals)
         out = self.client(rig, "chain")
         print(out)
         assert out["samples"] > 20 and out["goal_error"] < 0.002, out
+        assert out["between"] > 0, out  # something to judge the corners by
         # below 0.06 m on the verticals through the two points (within the tracking)
         assert out["stray"] < 0.003, out
         # between them it never went up to the 0.10 m travel height: the corners were cut

@@ -82,16 +82,17 @@ def chain(arm):
     arm.move_through(poses, ["linear", "joint", "linear"], blend_above=0.06)
     sub.unregister()
     time.sleep(0.2)
-    stray, crossed = 0.0, travel
-    for s in samples[::2]:
+    stray, crossed, between = 0.0, travel, 0
+    for s in samples:
         p = arm.compute_fk([s[n] for n in ARM]).pose.position
         off = min(math.dist((p.x, p.y), a), math.dist((p.x, p.y), b))
         if p.z < 0.06 - 0.001:
             stray = max(stray, off)
         elif off > 0.01:
-            crossed = min(crossed, p.z)
+            crossed, between = min(crossed, p.z), between + 1
     return {
         "samples": len(samples),
+        "between": between,
         "stray": stray,
         "crossed": crossed,
         "goal_error": pose_error(arm, *b, 0.04),
