@@ -100,14 +100,20 @@ struct CrowdedView {
     }
   }
 };
+
+/// What the planner looks at: `height` seen from `view`.
+GraspContext seenFrom(const cv::Mat& height, const CameraView& view) {
+  GraspContext context;
+  context.height = &height;
+  context.view = &view;
+  return context;
+}
 }  // namespace
 
 TEST(GraspPlanner, TurnsARoundSherdClearOfItsNeighboursButNotAnElongatedOne) {
   const GraspPlanner planner(withGripper());
   const CrowdedView crowd;
-  GraspContext context;
-  context.height = &crowd.height;
-  context.view = &crowd.view;
+  GraspContext context = seenFrom(crowd.height, crowd.view);
   // near-round (40 x 36 mm): across its minor axis the fingers land on the neighbours; turned
   // 90 degrees they close on a chord only 11 % longer, clear of them
   SherdDetection round = sherd(0.2, 0.25, 0.0, 0.040, 0.036, 0.008);
@@ -144,9 +150,7 @@ TEST(GraspPlanner, MovesTheGraspAlongAnElongatedSherdPastNeighboursBesideItsMidd
       if (dx >= -0.040 && dx <= 0.002 && dy >= 0.020 && dy <= 0.045) height.at<float>(v, u) = 0.010f;
     }
   }
-  GraspContext context;
-  context.height = &height;
-  context.view = &crowd.view;
+  GraspContext context = seenFrom(height, crowd.view);
   SherdDetection s = sherd(0.2, 0.25, 0.0, 0.062, 0.035, 0.008);
   planner.plan(s, &context);
   EXPECT_TRUE(s.grasp_clear);
@@ -171,9 +175,7 @@ TEST(GraspPlanner, TurnsASherdTooNarrowToHoldAcrossItsMinorAxis) {
   EXPECT_NEAR(planner.holdableChord(), 0.033, 1e-12);  // 30 mm shut + the 2 mm held margin + 1 mm
   const CrowdedView crowd;
   const cv::Mat empty = cv::Mat::zeros(crowd.height.size(), CV_32F);
-  GraspContext context;
-  context.height = &empty;
-  context.view = &crowd.view;
+  GraspContext context = seenFrom(empty, crowd.view);
   SherdDetection narrow = sherd(0.2, 0.25, 0.0, 0.047, 0.031, 0.012);
   planner.plan(narrow, &context);
   EXPECT_TRUE(narrow.grasp_clear);
@@ -209,9 +211,7 @@ TEST(GraspPlanner, ClosesUnderTheLowerEndOfASherdLeaningOnAnother) {
   Blob own;
   own.bounds = cv::boundingRect(inside);
   own.mask = inside(own.bounds).clone();
-  GraspContext context;
-  context.height = &height;
-  context.view = &crowd.view;
+  GraspContext context = seenFrom(height, crowd.view);
   context.own = &own;
   SherdDetection leaning = sherd(0.2, 0.25, 0.0, 0.050, 0.036, 0.036);
   leaning.support = 0.021;
