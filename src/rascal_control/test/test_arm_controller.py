@@ -262,7 +262,8 @@ class TestAgainstTheSimulator:
 
     @pytest.mark.paced
     def test_a_chain_goes_straight_up_and_down_and_cuts_the_corners_above_the_blend(self, rig):
-        # (as fast as it ran, under CI's load once no /joint_states came between the verticals)
+        # (as fast as it ran, under CI's load once none of the samples judged lay between the
+        # verticals, and `crossed` kept the travel height it starts from)
         out = self.client(rig, "chain")
         print(out)
         assert out["samples"] > 20 and out["goal_error"] < 0.002, out
