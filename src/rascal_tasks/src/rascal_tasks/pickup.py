@@ -51,6 +51,20 @@ class Pickup(BatchState):
             else:
                 b.sherd = SherdRecord.picked(b, o, b.pickup, tries)
             b.sherd.among_others = among_others(o, b.seen + b.leftovers, b.put_back_at)
+            b.log(  # what a heap's rows are traced from (bench/heap)
+                "sherd %d picked as %.0f x %.0f mm, top %.1f mm on %.1f mm, wall %.1f mm, %.0f %% "
+                "covered%s"
+                % (
+                    b.sherd.seq,
+                    o.length * 1000,
+                    o.width * 1000,
+                    o.height * 1000,
+                    o.support * 1000,
+                    o.thickness * 1000,
+                    o.covered * 100,
+                    ", among others" if b.sherd.among_others else "",
+                )
+            )
             return "held"
         attempts = b.config["recovery"]["max_grasp_attempts"]
         others, b.pending = b.pending, []  # the area changed under us: survey again

@@ -13,7 +13,7 @@ from typing import Callable, Dict, List, NamedTuple, Optional, Tuple, Type
 
 from rascal_tasks.archival import exposure
 from rascal_tasks.archival.exposure import Exposure
-from rascal_tasks.mass_and_size import more_than_one_sherd
+from rascal_tasks.mass_and_size import more_than_one_sherd, wall_heavier_than
 from rascal_tasks.rig import RigError, ScaleReading
 from rascal_tasks.wrist import same_grasp_yaws, standby_yaw
 
@@ -453,14 +453,15 @@ class ScaleStation(StationPlugin):
         if sherd.among_others:
             self._early_look = (sherd.seq, self._looked_at(sherd, back_to_hover=False))
 
-    def _looked_at(self, sherd, back_to_hover: bool) -> Optional[str]:
-        """A sherd picked from among others (SherdRecord.among_others) is looked at on the pan
-        while it settles: "double" when the wrist camera sees two sherds there (`_two_on_pan`;
-        put back LOOK_PUT_BACKS times at most: PutBack), else None, the arm back above the
-        sherd (`back_to_hover`, where the repick's descent starts) and the pan left to settle.
-        Seen as two again after that: recorded, flagged (`two_seen`), the batch incomplete."""
+    def _looked_at(self, sherd, back_to_hover: bool, anyway: bool = False) -> Optional[str]:
+        """A sherd picked from among others (SherdRecord.among_others), or any (`anyway`), is
+        looked at on the pan while it settles: "double" when the wrist camera sees two sherds
+        there (`_two_on_pan`; put back LOOK_PUT_BACKS times at most: PutBack), else None, the
+        arm back above the sherd (`back_to_hover`, where the repick's descent starts) and the
+        pan left to settle. Seen as two again after that: recorded, flagged (`two_seen`), the
+        batch incomplete."""
         b = self.batch
-        if not sherd.among_others:
+        if not (sherd.among_others or anyway):
             return None
         two, seen = self._two_on_pan(sherd)
         if len(seen) == 1:
@@ -525,11 +526,32 @@ class ScaleStation(StationPlugin):
             b.put_back_doubles[sherd.seq] = 1
             b.event(sherd, "two_in_one", too_heavy)
             return "double"
+        if not too_heavy and self._wall_doubted(sherd, reading.mass):
+            return "double"
         sherd.record_mass(reading.mass)
         if too_heavy:  # put back once already and as heavy again: one heavy sherd, flagged
             b.event(sherd, "mass_too_high", too_heavy)
             sherd.note("mass checked: %s; put back once and weighed alike again" % too_heavy)
         return "done"
+
+    def _wall_doubted(self, sherd, kg: float) -> bool:
+        """A sherd not looked at on the pan whose mass `kg` says the wall the pickup measured
+        was not one wall (mass_and_size.wall_heavier_than: it lay on something seen as part of
+        it) is looked at now: what it lay on may have come up with it (heap_20 seed 64: 23 g
+        wholly over 27 g, over a third sherd, weighed as one row; an outline and a mass of one).
+        True when the look saw two there ("double"). One seen alone gets its wall from the flat
+        pan (SherdRecord.measured_alone) instead of none."""
+        if sherd.among_others or not wall_heavier_than(sherd.size, kg):
+            return False
+        b = self.batch
+        b.log("sherd %d: %.1f g, its wall doubted: the pan looked at" % (sherd.seq, kg * 1000))
+        over = b.next_stays(self.index) is not None
+        if over:  # the camera over the scale: the fingers stand round it (measure_here), go up
+            from rascal_tasks.station_states import hover_z  # station_states imports this module
+
+            x, y = sherd.last_xy
+            b.move_down(x, y, hover_z(b, self.station, sherd), sherd.grasp_yaw, linear=True)
+        return self._looked_at(sherd, back_to_hover=not over, anyway=True) == "double"
 
     def _two_on_pan(self, sherd) -> Tuple[str, list]:
         """Why the wrist camera's look at the pan shows two sherds where `sherd` was set down, or
