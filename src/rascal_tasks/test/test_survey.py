@@ -5,6 +5,7 @@ against the in-memory rig of `fake_rig.py` (its view a circle; `World.view_cuts`
 cut sherds as the image border does)."""
 
 import math
+from dataclasses import replace
 from types import SimpleNamespace
 
 import pytest
@@ -148,6 +149,16 @@ def test_the_sherd_counted_taken_is_the_one_grasped_not_the_one_looked_for():
     # picked up again after a drop (no sherd of the survey taken for): only if it is one
     taken_off_the_mat(b, _seen(0.20, 0.20))
     assert len(b.taken_since_survey) == 2
+    # heap_20 seed 65: the sherd looked for, nudged 22 mm by a grasp beside it, is grasped by
+    # the fresh look 7 mm from a larger sherd of the survey that still lies there: the one
+    # looked for is taken, not that one (which, counted taken, left this one "pushed off")
+    lost, big = _seen(0.0635, 0.2957, 0.050), replace(_seen(0.0424, 0.3068, 0.056), width=0.047)
+    b = SimpleNamespace(seen=[lost, big], taken_since_survey=[])
+    taken_off_the_mat(b, _seen(0.048, 0.311, 0.050), surveyed=lost)
+    assert b.taken_since_survey == [(lost.x, lost.y)]
+    # of a size with neither: the nearest, as before
+    taken_off_the_mat(b, _seen(0.048, 0.311, 0.030), surveyed=lost)
+    assert b.taken_since_survey[-1] == (big.x, big.y)
 
 
 def _batch(leftovers=()):

@@ -173,12 +173,25 @@ def near_the_edge(area, o: Observation) -> bool:
 
 def taken_off_the_mat(b, grasped: Observation, surveyed: Optional[Observation] = None):
     """Note for the edge check which sherd of the last survey (`b.seen`) has left the mat: the
-    one the `grasped` detection (often a fresh look's) is, its nearest within SAME_SHERD (one
-    uncovered since shows more of itself, its centre shifted); else `surveyed`, the one it was
-    taken for. A fresh look may grasp a neighbour instead of the sherd it looked for, which
-    then still lies on the mat (heap seed 36: the sherd grasped was counted as still there)."""
-    near = [c for c in b.seen if c.distance_to(grasped.x, grasped.y) <= SAME_SHERD]
-    it = min(near, key=lambda c: c.distance_to(grasped.x, grasped.y), default=surveyed)
+    one the `grasped` detection (often a fresh look's) is. Its nearest within SAME_SHERD of
+    its size first; else `surveyed`, the one it was taken for, when of its size (a grasp
+    beside it may have nudged it further: heap_20 seed 65, 22 mm, and the nearest, a sherd of
+    another size still lying there, was counted taken instead and this one said pushed off the
+    mat); else its nearest within SAME_SHERD (one uncovered since shows more of itself, its
+    centre shifted); else `surveyed`. A fresh look may grasp a neighbour instead of the sherd
+    it looked for, which then still lies on the mat (heap seed 36: the sherd grasped was
+    counted as still there)."""
+    near = sorted(
+        (c for c in b.seen if c.distance_to(grasped.x, grasped.y) <= SAME_SHERD),
+        key=lambda c: c.distance_to(grasped.x, grasped.y),
+    )
+    alike = [c for c in near if same_size(grasped, c)]
+    if alike:
+        it = alike[0]
+    elif surveyed is not None and same_size(grasped, surveyed):
+        it = surveyed
+    else:
+        it = near[0] if near else surveyed
     if it is not None:
         b.taken_since_survey.append((it.x, it.y))
 
