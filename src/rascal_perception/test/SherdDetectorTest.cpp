@@ -643,38 +643,6 @@ TEST(StackedSherds, ASherdOnAnotherIsCutOutAlongItsStepAndOfferedFirst) {
   EXPECT_GE(under_covered, 0.9 * under_found);
 }
 
-
-TEST(StackedSherds, Explore_WhollyOver) {
-  for (unsigned seed = 131; seed <= 136; ++seed) {
-    rascal_sim::Scenario sc = generated(seed, 6, 1.0, 5600, 0.0);
-    for (size_t i = 0; i + 1 < sc.sherds.size(); i += 2) {
-      rascal_sim::SherdSpec& low = sc.sherds[i];
-      rascal_sim::SherdSpec& top = sc.sherds[i + 1];
-      top.curvature = top.curvature_long = 0.0;
-      const rascal_sim::SherdGeometry g = rascal_sim::SherdMeshBuilder::build(low);
-      const Eigen::Vector2d along(std::cos(low.pose.z()), std::sin(low.pose.z()));
-      top.pose.head<2>() = low.pose.head<2>() + 0.1 * g.box_size.x() * along;
-      top.pose.z() = low.pose.z() + 0.2;
-      top.drop_height = g.box_size.z();
-    }
-    const Frame f = render(sc, surveyJoints());
-    SherdDetector d(config());
-    const DetectionResult r = calibrateAndDetect(sc, f, d);
-    save("wholly_" + std::to_string(seed), f, r);
-    for (size_t i = 0; i + 1 < f.truth.size(); i += 2) {
-      const Truth &low = f.truth[i], &top = f.truth[i + 1];
-      if (!fullyInView(low, f.view) || !fullyInView(top, f.view)) continue;
-      std::printf("seed %u pair %zu: low %.0fx%.0f t%.1f top@%.1f; top %.0fx%.0f t%.1f top@%.1f\n", seed, i,
-                  low.length * 1e3, low.width * 1e3, low.thickness * 1e3, low.top * 1e3, top.length * 1e3,
-                  top.width * 1e3, top.thickness * 1e3, top.top * 1e3);
-      for (const SherdDetection& s : r.sherds) {
-        if ((s.centre.head<2>() - top.centre).norm() > 0.04) continue;
-        std::printf("   det %.0fx%.0f h%.1f support %.1f wall %.1f covered %.2f\n", s.length * 1e3, s.width * 1e3,
-                    s.height * 1e3, s.support * 1e3, s.thickness * 1e3, s.covered);
-      }
-    }
-  }
-}
 TEST(SherdDetector, AViewCloserThanTheSurveysMeasuresEverySherdsWallToo) {
   // Each sherd of demo_10 looked at from ee_gripper_link 0.17 m over the mat (the camera
   // ~0.22 m, against the survey's ~0.30 m), the background learnt at the survey height. Before
