@@ -571,6 +571,34 @@ def test_a_sherd_whose_mass_doubts_its_wall_is_looked_at_and_two_there_put_back(
     assert all(s.station == "discard" for s in world.sherds)
 
 
+def test_a_sherd_whose_mass_doubts_its_wall_and_seen_alone_is_taken_up_high_on_its_edge(
+    config, monkeypatch
+):
+    # seen as one outline on the pan too, it may still be two (a rider as wide as the one
+    # under it): the fingertips close MIN_WALL below the lowest point of its top there, on a
+    # rider's edge and above the one under it; a sherd alone is held by its upper edge
+    import rascal_tasks.manipulation as manipulation
+
+    grasps, real = [], manipulation.grasp
+
+    def counted(b, o, station, **kw):
+        grasps.append((station.name, round(o.grasp_z - station.surface_z, 4)))
+        return real(b, o, station, **kw)
+
+    monkeypatch.setattr(manipulation, "grasp", counted)
+    world = World(config, [Sherd("a", 0.10, 0.22, lifted_wall=0.02)])
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished" and recorder.status() == {1: "done"}
+    high = round(0.007 - manipulation.MIN_WALL + manipulation.FINGERTIP_OFFSET, 4)
+    assert ("scale", high) in grasps, grasps
+    # its wall not doubted (its mass fits it): taken up by the look's grasp as it was
+    grasps.clear()
+    world = World(config, [Sherd("a", 0.10, 0.22)])
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished" and ("scale", high) not in grasps, grasps
+    assert any(st == "scale" for st, _ in grasps), grasps
+
+
 def test_a_sherd_picked_alone_is_not_looked_at_on_the_scale(config, monkeypatch):
     # nothing lay on it (selection.among_others), even with a neighbour beside it: the scale
     # is not looked at, so a spread-out batch pays nothing for the check

@@ -115,6 +115,14 @@ def regrasp_z(b, station) -> float:
     return station.surface_z + tip + FINGERTIP_OFFSET
 
 
+def rider_z(station, o: Observation) -> float:
+    """ee_gripper_link height that closes the fingertips MIN_WALL below the lowest point of the
+    top of `o` seen on `station` (its measured wall): on the edge of whatever lies on top,
+    which is at least that thick, and above anything under it (two seen as one outline, heap_20
+    seed 64); a single sherd is held by its upper edge."""
+    return station.surface_z + o.thickness - MIN_WALL + FINGERTIP_OFFSET
+
+
 def placed_observation(b, s, station) -> Observation:
     """Where the sherd in progress `s` was set down on `station`, as it was held: the blind
     grasp that picks it up again (`station_states.repick`). At the height it was picked up at
@@ -126,12 +134,15 @@ def placed_observation(b, s, station) -> Observation:
     SherdRecord.measured_alone) is taken up by that detection's grasp, as it lies (its wrist
     turned as the gripper is: the fingers are alike), not where and as it was set down (heap_20
     seed 60: 7 of the 8 blind closes on the pan that met nothing came after a look that saw
-    the sherd alone there)."""
+    the sherd alone there); high on its edge where its wall was doubted (rider_z)."""
     if s.seen_set_down is not None:
         o = s.seen_set_down
         back = (o.grasp_yaw, o.grasp_yaw + math.pi)
         yaw = min(back, key=lambda g: abs(math.remainder(g - s.grasp_yaw, 2.0 * math.pi)))
-        return dataclasses.replace(o, grasp_yaw=math.remainder(yaw, 2.0 * math.pi))
+        o = dataclasses.replace(o, grasp_yaw=math.remainder(yaw, 2.0 * math.pi))
+        if s.wall_doubted and o.thickness > 0.0:
+            o = dataclasses.replace(o, grasp_z=max(o.grasp_z, rider_z(station, o)))
+        return o
     x, y = s.last_xy
     z = station.surface_z + s.grasp_height
     if lifted_off_another(s):

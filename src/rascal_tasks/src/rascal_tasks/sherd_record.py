@@ -38,6 +38,9 @@ class SherdRecord:
         self.among_others = False
         # seen alone where it was set down (the scale's look: measured_alone): its take-up there
         self.seen_set_down: Optional[Observation] = None
+        # its mass said the wall the pickup measured was not one wall (stations.ScaleStation.
+        # _wall_doubted): something it lay on may have come up with it
+        self.wall_doubted = False
         self.drops = 0
         self.mass: Optional[float] = None
         self.bin: Optional[str] = None  # the sorting bin it goes into (stations.DiscardStation)

@@ -540,11 +540,14 @@ class ScaleStation(StationPlugin):
         it) is looked at now: what it lay on may have come up with it (heap_20 seed 64: 23 g
         wholly over 27 g, over a third sherd, weighed as one row; an outline and a mass of one).
         True when the look saw two there ("double"). One seen alone gets its wall from the flat
-        pan (SherdRecord.measured_alone) instead of none."""
+        pan (SherdRecord.measured_alone) instead of none, and is taken up high on its edge
+        (manipulation.placed_observation): one lying on it is lifted off it, and the other,
+        left on the pan, weighed out of the row by difference (_left_on_pan)."""
         if sherd.among_others or not wall_heavier_than(sherd.size, kg):
             return False
         b = self.batch
         b.log("sherd %d: %.1f g, its wall doubted: the pan looked at" % (sherd.seq, kg * 1000))
+        sherd.wall_doubted = True
         over = b.next_stays(self.index) is not None
         if over:  # the camera over the scale: the fingers stand round it (measure_here), go up
             from rascal_tasks.station_states import hover_z  # station_states imports this module
