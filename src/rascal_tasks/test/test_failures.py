@@ -575,8 +575,9 @@ def test_a_sherd_whose_mass_doubts_its_wall_and_seen_alone_is_taken_up_high_on_i
     config, monkeypatch
 ):
     # seen as one outline on the pan too, it may still be two (a rider as wide as the one
-    # under it): the fingertips close MIN_WALL below the lowest point of its top there, on a
-    # rider's edge and above the one under it; a sherd alone is held by its upper edge
+    # under it: heap_20 seeds 59, 64): the fingertips close MIN_WALL below the lowest point of
+    # its top there, on a rider's edge and above the one under it, which stays on the pan and
+    # is weighed out of the row by difference; a sherd alone is held by its upper edge
     import rascal_tasks.manipulation as manipulation
 
     grasps, real = [], manipulation.grasp
@@ -597,6 +598,14 @@ def test_a_sherd_whose_mass_doubts_its_wall_and_seen_alone_is_taken_up_high_on_i
     outcome, batch, recorder = _run(config, world)
     assert outcome == "finished" and ("scale", high) not in grasps, grasps
     assert any(st == "scale" for st, _ in grasps), grasps
+    # a 16 mm wall, thicker than a body sherd's (manipulation.THICK_WALL), its mass no reason
+    # to doubt it and not looked at: taken up high on its edge by its wall seen on the mat
+    grasps.clear()
+    world = World(config, [Sherd("a", 0.10, 0.22, height=0.018, thickness=0.016, mass=0.04)])
+    outcome, batch, recorder = _run(config, world)
+    assert outcome == "finished" and recorder.sherds[1].size[2] == pytest.approx(0.016)
+    high = round(0.016 - manipulation.MIN_WALL + manipulation.FINGERTIP_OFFSET, 4)
+    assert ("scale", high) in grasps, grasps
 
 
 def test_a_sherd_picked_alone_is_not_looked_at_on_the_scale(config, monkeypatch):

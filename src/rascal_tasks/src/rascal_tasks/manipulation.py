@@ -23,6 +23,10 @@ FINGERTIP_OFFSET = urdf_model.fingertip_offset()
 # [m] the thinnest sherd wall (fine ware, facts/sherds_and_colour.md): a sherd lying on a
 # station is at least this high where the fingers close
 MIN_WALL = 0.003
+# [m] thicker than a body sherd's wall usually is (body 5-10 mm, typical 6-8 mm: facts/
+# sherds_and_colour.md §2, [S15]): seen from above, such a wall may be two sherds lying one
+# wholly on the other, so the sherd is taken up on a station high on its edge (rider_z)
+THICK_WALL = 0.010
 # [m] fingers this much short of the opening they were sent to stopped on something: the
 # controller calls a finger within 0.5 mm of its target there (GripperMonitor::kFingerReached)
 RELEASE_SLACK = 0.002
@@ -117,10 +121,18 @@ def regrasp_z(b, station) -> float:
 
 def rider_z(station, o: Observation) -> float:
     """ee_gripper_link height that closes the fingertips MIN_WALL below the lowest point of the
-    top of `o` seen on `station` (its measured wall): on the edge of whatever lies on top,
-    which is at least that thick, and above anything under it (two seen as one outline, heap_20
-    seed 64); a single sherd is held by its upper edge."""
+    top of `o` lying on `station` (its measured wall): on the edge of whatever lies on top,
+    which is at least that thick, and above anything under it (two seen as one outline: heap_20
+    seeds 59, 64); a single sherd is held by its upper edge. What stays on a scale's pan is
+    weighed out of the row by difference (stations.ScaleStation._left_on_pan)."""
     return station.surface_z + o.thickness - MIN_WALL + FINGERTIP_OFFSET
+
+
+def maybe_two(s, o: Observation) -> bool:
+    """Whether `o`, the sherd in progress `s` as it lies on a station (seen there, or as picked
+    from the mat's surface), may be two sherds seen as one: its mass doubted the wall picked
+    (SherdRecord.wall_doubted), or its wall is thicker than THICK_WALL."""
+    return o.thickness > 0.0 and (s.wall_doubted or o.thickness > THICK_WALL)
 
 
 def placed_observation(b, s, station) -> Observation:
@@ -134,19 +146,22 @@ def placed_observation(b, s, station) -> Observation:
     SherdRecord.measured_alone) is taken up by that detection's grasp, as it lies (its wrist
     turned as the gripper is: the fingers are alike), not where and as it was set down (heap_20
     seed 60: 7 of the 8 blind closes on the pan that met nothing came after a look that saw
-    the sherd alone there); high on its edge where its wall was doubted (rider_z)."""
+    the sherd alone there). High on its edge where it may be two seen as one (maybe_two,
+    rider_z)."""
     if s.seen_set_down is not None:
         o = s.seen_set_down
         back = (o.grasp_yaw, o.grasp_yaw + math.pi)
         yaw = min(back, key=lambda g: abs(math.remainder(g - s.grasp_yaw, 2.0 * math.pi)))
         o = dataclasses.replace(o, grasp_yaw=math.remainder(yaw, 2.0 * math.pi))
-        if s.wall_doubted and o.thickness > 0.0:
+        if maybe_two(s, o):
             o = dataclasses.replace(o, grasp_z=max(o.grasp_z, rider_z(station, o)))
         return o
-    x, y = s.last_xy
+    x, y, picked = *s.last_xy, s.observation
     z = station.surface_z + s.grasp_height
     if lifted_off_another(s):
         z = min(z, regrasp_z(b, station))
+    elif picked is not None and picked.support <= STACKED and maybe_two(s, picked):
+        z = max(z, rider_z(station, picked))  # it lay on the mat itself: its wall as seen there
     return Observation(
         x,
         y,
