@@ -5,7 +5,7 @@ sherd up (pickup, repick, recovery, resume). No ROS in here.
 import contextlib
 import dataclasses
 import math
-from typing import Tuple
+from typing import Optional, Tuple
 
 from rascal_workcell import urdf_model
 
@@ -148,20 +148,21 @@ def placed_observation(b, s, station) -> Observation:
     seed 60: 7 of the 8 blind closes on the pan that met nothing came after a look that saw
     the sherd alone there). High on its edge where it may be two seen as one (maybe_two,
     rider_z)."""
+    high = taken_up_high(s)
     if s.seen_set_down is not None:
         o = s.seen_set_down
         back = (o.grasp_yaw, o.grasp_yaw + math.pi)
         yaw = min(back, key=lambda g: abs(math.remainder(g - s.grasp_yaw, 2.0 * math.pi)))
         o = dataclasses.replace(o, grasp_yaw=math.remainder(yaw, 2.0 * math.pi))
-        if maybe_two(s, o):
-            o = dataclasses.replace(o, grasp_z=max(o.grasp_z, rider_z(station, o)))
+        if high is not None:
+            o = dataclasses.replace(o, grasp_z=max(o.grasp_z, rider_z(station, high)))
         return o
-    x, y, picked = *s.last_xy, s.observation
+    x, y = s.last_xy
     z = station.surface_z + s.grasp_height
     if lifted_off_another(s):
         z = min(z, regrasp_z(b, station))
-    elif picked is not None and picked.support <= STACKED and maybe_two(s, picked):
-        z = max(z, rider_z(station, picked))  # it lay on the mat itself: its wall as seen there
+    elif high is not None:
+        z = max(z, rider_z(station, high))
     return Observation(
         x,
         y,
@@ -175,6 +176,19 @@ def placed_observation(b, s, station) -> Observation:
         s.grasp_yaw,
         opening_for(s.width, b.config["arm"]["grasp_margin"], openings(b.config)),
     )
+
+
+def taken_up_high(s) -> Optional[Observation]:
+    """The detection of the sherd in progress `s` as it lies on a station (the look's there, or
+    the pickup's where it lay on the mat itself: its wall the same) when that says it may be
+    two seen as one (maybe_two), to be taken up high on its edge (rider_z); else None."""
+    if s.seen_set_down is not None:
+        o = s.seen_set_down
+    elif s.observation is not None and not lifted_off_another(s):
+        o = s.observation if s.observation.support <= STACKED else None
+    else:
+        o = None
+    return o if o is not None and maybe_two(s, o) else None
 
 
 def lifted_off_another(s) -> bool:
@@ -197,6 +211,8 @@ def grasp_where_set_down(b, s, station) -> bool:
     o = placed_observation(b, s, station)
     if grasp(b, o, station, lift_on_miss=False):
         s.taken_up_at(o.grasp_z, station)  # (low already, for one lifted_off_another)
+        if taken_up_high(s) is not None:  # what it lay on may stay (ScaleStation.while_away)
+            s.parted_on = station.name
         return True
     low = regrasp_z(b, station)
     if low > o.grasp_z - MIN_WALL / 2:  # as low already: a miss there is a miss

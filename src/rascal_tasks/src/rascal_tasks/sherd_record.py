@@ -41,6 +41,9 @@ class SherdRecord:
         # its mass said the wall the pickup measured was not one wall (stations.ScaleStation.
         # _wall_doubted): something it lay on may have come up with it
         self.wall_doubted = False
+        # the station it was last taken up from high on its edge (manipulation.rider_z), where
+        # what it lay on may have stayed: the scale reads that before the row is done
+        self.parted_on: Optional[str] = None
         self.drops = 0
         self.mass: Optional[float] = None
         self.bin: Optional[str] = None  # the sorting bin it goes into (stations.DiscardStation)

@@ -251,6 +251,16 @@ class ScaleStation(StationPlugin):
         if self._early_tare is not None:
             return False
         b, cfg = self.batch, self._cfg()
+        last = self._last
+        if arm_free and last is not None and last.parted_on == self.station.name:
+            # taken up high on its edge (manipulation.rider_z): the sherd it lay on may lie on
+            # the pan still, weighed with it; read (waited for, within stable_timeout) while
+            # that row is open, to be taken out of it by difference (heap_20 seed 59: left
+            # there and weighed over by the next sherd, the row kept both masses)
+            last.parted_on = None
+            left, _ = self._settle(b.rig.clock.now() - cfg["stable_window"] - 1.0)
+            if left is not None and left.mass >= MIN_SHERD_MASS:
+                return self._left_on_pan(left.mass)
         # steady within the last digit either way (the empty pan's noise flips it both ways
         # about one window in seven): a pan still moving when tared is caught by the check
         # after the tare (reads_zero), which allows no more
