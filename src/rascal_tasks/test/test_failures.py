@@ -472,6 +472,32 @@ def test_two_sherds_lifted_as_one_are_put_back_apart_and_recorded_a_row_each(con
     assert all(s.station == "discard" for s in world.sherds)
 
 
+def _lying(x, y, length=0.05):
+    return Observation(x, y, 0.0, length, 0.8 * length, 0.006, x, y, 0.01, 0.0, 0.06)
+
+
+def test_what_is_put_back_goes_where_sherds_and_the_mat_edge_leave_most_room(config):
+    from rascal_tasks.station_states import free_spot
+
+    area = config.stations["pickup"].area
+    (cx, cy), (sx, sy) = area.center, area.size
+
+    def edge(p):
+        return min(sx / 2 - abs(p[0] - cx), sy / 2 - abs(p[1] - cy))
+
+    assert free_spot(area, []) == pytest.approx((cx, cy), abs=0.006)  # an empty mat: its middle
+    # a heap in the middle (heap_20 seed 59): not on the inset's line along the edge, where two
+    # put back rolled to the edge, but between the heap and the edge
+    heap = [_lying(cx + dx, cy + dy) for dx in (-0.03, 0.0, 0.03) for dy in (-0.02, 0.02)]
+    spot = free_spot(area, heap)
+    assert edge(spot) > 0.045
+    assert min(o.distance_to(*spot) - o.length / 2 for o in heap) > 0.045
+    # sherds all along one long edge: the spot moves to the other side, still off its edge
+    row = [_lying(cx + dx, cy - sy / 2 + 0.03) for dx in (-0.12, -0.06, 0.0, 0.06, 0.12)]
+    spot = free_spot(area, row)
+    assert spot[1] > cy and edge(spot) > 0.04
+
+
 def test_a_light_sherd_riding_on_a_neighbour_is_seen_on_the_scale_and_put_back(config, monkeypatch):
     # b (5 g) lies on a's edge and rides along on its grasp: 25 g is within what one 50 x 40 mm
     # sherd with a 7 mm wall can weigh (35 g), so the mass alone cannot tell. a was picked with

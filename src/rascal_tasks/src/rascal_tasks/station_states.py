@@ -3,6 +3,7 @@ STATION_i runs the station's plug-in (`stations.py`), REPICK_i picks it up again
 takes two sherds lifted as one back to the pickup mat, apart. No ROS here.
 """
 
+import math
 from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
@@ -331,16 +332,27 @@ def clear_to_mat(b, st, spot=None) -> Optional[Tuple[float, float]]:
 
 
 def free_spot(area, seen, step=0.01, inset=0.035):
-    """The point of `area` (config.Rect; `inset` from its edges: half a large sherd) farthest
-    from the outlines of the sherds `seen` there (their centres less half their length)."""
+    """The point of `area` (config.Rect; at least `inset` from its edges: half a large sherd)
+    with the most room around it: farthest from the outlines of the sherds `seen` there (their
+    centres less half their length) and from the mat's edge alike. The edge counts as an
+    outline because what is set down there can fall apart or roll over it (heap_20 seed 59: two
+    put back 35 mm from the edge, where the heap left the most room, rolled to it and one was
+    pushed off by a later grasp beside it); an empty mat's freest spot is its middle."""
     (cx, cy), (sx, sy) = area.center, area.size
-    best, room = (cx, cy), -1.0
     nx, ny = max(1, int((sx - 2 * inset) / step)), max(1, int((sy - 2 * inset) / step))
-    for i in range(nx + 1):
-        for j in range(ny + 1):
-            x = cx - sx / 2 + inset + i * (sx - 2 * inset) / nx
-            y = cy - sy / 2 + inset + j * (sy - 2 * inset) / ny
-            r = min((o.distance_to(x, y) - o.length / 2 for o in seen), default=1.0)
-            if r > room:
-                best, room = (x, y), r
+    grid = [
+        (
+            cx - sx / 2 + inset + i * (sx - 2 * inset) / nx,
+            cy - sy / 2 + inset + j * (sy - 2 * inset) / ny,
+        )
+        for i in range(nx + 1)
+        for j in range(ny + 1)
+    ]
+    grid.sort(key=lambda p: math.hypot(p[0] - cx, p[1] - cy))  # of equal room, the middlemost
+    best, room = (cx, cy), -1.0
+    for x, y in grid:
+        edge = min(sx / 2 - abs(x - cx), sy / 2 - abs(y - cy))
+        r = min([o.distance_to(x, y) - o.length / 2 for o in seen] + [edge])
+        if r > room + 1e-9:
+            best, room = (x, y), r
     return best
