@@ -123,6 +123,40 @@ def test_what_a_thick_sherd_taken_up_high_leaves_on_the_pan_is_weighed_out_of_it
     assert {s.station for s in world.sherds} == {"discard"}
 
 
+def test_one_outline_whose_wall_its_mass_rules_out_that_leaves_nothing_is_flagged(config):
+    # heap_20 seed 64: a sherd wholly on one of its size is seen as one outline on the pan too,
+    # its wall there more than its mass allows for one sherd; the take-up high on its edge
+    # lifted both (nothing stayed on the pan): the row stands as weighed, flagged `maybe_two`,
+    # and the batch says so; had something stayed, it is weighed out of the row instead
+    world = World(config, [Sherd("a", 0.10, 0.22, mass=0.025)])
+    outcome, batch, rec = run_batch(config, world)
+    assert outcome == "finished" and not batch.maybe_two
+    scale = next(p for p in batch.plugins if p.station.name == "scale")
+    last = scale._last
+    world.t += 10.0  # the pan empty and settled
+    last.parted_on, last.wall_doubted_alone = "scale", True
+    scale._early_tare = None
+    scale.while_away(arm_free=True)
+    assert batch.maybe_two == [last.seq]
+    assert any(n.startswith("maybe_two: seen as one outline") for n in rec.sherds[last.seq].notes)
+    from rascal_tasks.run_batch import what_is_left
+
+    assert "may be two lying as one (`maybe_two`)" in what_is_left(batch, [])
+    # a wall its mass allows (not doubted alone), or something left on the pan: no flag
+    batch.maybe_two.clear()
+    last.parted_on, last.wall_doubted_alone = "scale", False
+    scale.while_away(arm_free=True)
+    assert not batch.maybe_two
+    left = Sherd("left", 0.0, 0.0, mass=0.01)
+    world.sherds.append(left)
+    world.put(left, *config.stations["scale"].place_at)
+    world.t += 10.0
+    last.parted_on, last.wall_doubted_alone, last.status = "scale", True, "done"
+    scale._early_tare = None  # (the empty pan was tared above)
+    scale.while_away(arm_free=True)
+    assert not batch.maybe_two and left.station == "pickup"
+
+
 def test_a_sherd_recorded_lost_on_the_scale_is_left_there(config):
     """What lies on the pan after the scale's last sherd was recorded lost there, or what weighs
     what it weighed (dropped back unseen), is most likely that sherd: it is left for a person,

@@ -90,6 +90,7 @@ class Batch:
         self.put_back_doubles = {}  # seq -> times its grasp was put back as two sherds in one
         self.put_back_at = []  # (x, y) of the pickup mat where a put back set sherds down
         self.two_seen = []  # seqs recorded with a second sherd seen on the scale (put back twice)
+        self.maybe_two = []  # seqs recorded as one outline whose wall its mass rules out (a note)
         # an unmeasured sherd back among the bag's on the mat: its number goes to the next pick
         self.renumber: Optional[SherdRecord] = None
         self.renumber_unused = ""  # why that row is recorded lost if the mat empties first

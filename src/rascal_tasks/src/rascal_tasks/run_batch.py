@@ -286,6 +286,7 @@ class Run:
                 batch.pushed_to = done[-1].pushed_to
                 batch.put_back_at = done[-1].put_back_at
                 batch.two_seen = done[-1].two_seen
+                batch.maybe_two = done[-1].maybe_two
             progress.batch = batch
             self.batch, self.machine = batch, build_machine(batch)
             if self.stop.is_set():  # Ctrl-C while the machine was being built
@@ -498,8 +499,9 @@ def what_is_left(batch, rows) -> str:
     """What a person must see to after a finished batch ('' when the bag is complete): sherds
     left on the mat, objects on it perception does not offer as sherds, rows of the context
     lost, without a mass (the scale gave none that could be trusted: mass_unstable, or done with
-    mass_missing_reason) or unfinished, and rows weighed with a second sherd seen on the scale
-    (stations.LOOK_PUT_BACKS)."""
+    mass_missing_reason) or unfinished, rows weighed with a second sherd seen on the scale
+    (stations.LOOK_PUT_BACKS), and rows that may be two lying as one (stations.ScaleStation.
+    _maybe_two)."""
     rows = rows or []
     counts = (
         (len(batch.unpickable), "left on the pickup mat (could not be picked up)"),
@@ -511,6 +513,7 @@ def what_is_left(batch, rows) -> str:
         ),
         (sum(r["status"] not in ("done", "lost") for r in rows), "unfinished"),
         (len(batch.two_seen), "recorded with a second sherd seen on the scale (`two_seen`)"),
+        (len(batch.maybe_two), "recorded as one that may be two lying as one (`maybe_two`)"),
     )
     parts = ["%d sherd%s %s" % (n, "" if n == 1 else "s", what) for n, what in counts if n]
     if batch.leftovers:  # perhaps not sherds at all: a chip, a pebble, a label

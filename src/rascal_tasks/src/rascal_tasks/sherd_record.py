@@ -44,6 +44,10 @@ class SherdRecord:
         # the station it was last taken up from high on its edge (manipulation.rider_z), where
         # what it lay on may have stayed: the scale reads that before the row is done
         self.parted_on: Optional[str] = None
+        # seen alone on a station, its wall there still more than its mass allows for one sherd
+        # of its outline (measured_alone): two lying as one, perhaps, if the take-up high on its
+        # edge leaves nothing behind (stations.ScaleStation.while_away flags it)
+        self.wall_doubted_alone = False
         self.drops = 0
         self.mass: Optional[float] = None
         self.bin: Optional[str] = None  # the sorting bin it goes into (stations.DiscardStation)
@@ -171,17 +175,18 @@ class SherdRecord:
         taken up by this one's grasp (manipulation.placed_observation)."""
         self.seen_set_down = o
         self.record_dimensions(o)
-        if self.mass is not None:
-            self._check_wall()
+        if self.mass is not None and self._check_wall():
+            self.wall_doubted_alone = True
 
-    def _check_wall(self):
+    def _check_wall(self) -> bool:
         """A recorded wall that its mass says cannot be one wall (mass_and_size.
-        wall_heavier_than) is taken back out of the row, the figure kept in a note."""
+        wall_heavier_than) is taken back out of the row, the figure kept in a note; True then."""
         why = wall_heavier_than(self.size, self.mass)
         if not why:
-            return
+            return False
         self.batch.event(self, "wall_not_recorded", why)  # the note keeps the figure
         self.record_dimensions(dataclasses.replace(self.size, thickness=0.0))
+        return True
 
     def record_mass_unstable(self, reason: str):
         """The scale gave no trustworthy mass: the row says why and has no mass."""

@@ -261,6 +261,8 @@ class ScaleStation(StationPlugin):
             left, _ = self._settle(b.rig.clock.now() - cfg["stable_window"] - 1.0)
             if left is not None and left.mass >= MIN_SHERD_MASS:
                 return self._left_on_pan(left.mass)
+            if last.wall_doubted_alone:
+                self._maybe_two(last, left)
         # steady within the last digit either way (the empty pan's noise flips it both ways
         # about one window in seven): a pan still moving when tared is caught by the check
         # after the tare (reads_zero), which allows no more
@@ -282,6 +284,28 @@ class ScaleStation(StationPlugin):
             return False
         self._early_tare = (b.rig.clock.now(), empty.mass)
         return False
+
+    def _maybe_two(self, sherd, left) -> None:
+        """`sherd`, seen as one outline on the pan whose wall there its mass still rules out for
+        one sherd (SherdRecord.wall_doubted_alone), was taken up high on its edge and left
+        nothing behind (`left`: the pan's settled reading since, None when it did not settle):
+        two sherds of one outline may have come up together (heap_20 seed 64: a sherd wholly on
+        one of its size, 50.2 g, seen as one on the pan, both lifted by the lower one's edge,
+        weighed as one row, exit 0). Its row stands as weighed, with a note saying so, and the
+        batch ends incomplete: a person looks, rather than a row of two passing as one sherd."""
+        b = self.batch
+        why = (
+            "seen as one outline on the %s, its wall there more than %.1f g allows for "
+            "one sherd of that outline, and nothing stayed on the pan when it was taken up high on "
+            "its edge%s; a person should check that this row is one sherd"
+            % (
+                self.station.name,
+                (sherd.mass or 0.0) * 1000,
+                "" if left is not None else " (the pan did not settle)",
+            )
+        )
+        b.maybe_two.append(sherd.seq)
+        b.event(sherd, "maybe_two", why)  # (the event is the row's note too)
 
     def _left_on_pan(self, kg: float) -> bool:
         """`kg` lies on the pan, settled, since the sherd weighed here was lifted off it: a
