@@ -54,6 +54,9 @@ class Sherd:
     # a sherd under it that the wrist camera sees as part of it (one outline from above) lifts
     # the wall the depth measures by this much, until it is set down elsewhere
     lifted_wall: float = 0.0
+    # [rad] perception turns its grasp this far off closing across its width (neighbours in
+    # the way): the detection's grasp_yaw
+    grasp_turn: float = 0.0
 
     @property
     def chord(self) -> float:
@@ -357,7 +360,7 @@ class _Perception(rig.Perception):
                 s.x,
                 s.y,
                 surface + s.support + GRASP_ABOVE,
-                0.0,
+                s.grasp_turn,
                 s.width + 0.012,
                 thickness=s.thickness + s.lifted_wall,
                 support=s.support,

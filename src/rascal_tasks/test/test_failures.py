@@ -160,6 +160,39 @@ def test_a_sherd_that_slips_out_as_often_as_allowed_gives_its_number_on_and_wait
     assert {s.station for s in world.sherds} == {"discard"}
 
 
+def test_a_sherd_dropped_from_a_grasp_turned_amid_others_waits_for_them(config):
+    """a, among others, is grasped along its length (perception turned the grasp 90 deg to
+    clear its neighbours) and slips out on its way to the scale, back onto the mat, where its
+    grasp is as turned as before: it is not grasped again so (heap_25_offcentre seed 71: the
+    same grasp dropped it three times) but taken after the others, its number going to the next
+    sherd picked; one drop in all, every sherd recorded once."""
+    # (b, free, goes first; of a and c, both turned, a, the nearer, is tried first)
+    turned = math.pi / 2
+    world = World(
+        config,
+        [
+            Sherd("a", 0.10, 0.22, grasp_turn=turned),
+            Sherd("b", 0.25, 0.30),
+            Sherd("c", 0.22, 0.20, grasp_turn=turned),
+        ],
+    )
+    world.slips["a"] = (0.11, 0.22)  # once: taken later, it holds (its neighbours gone)
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished"
+    assert rec.status() == {1: "done", 2: "done", 3: "done"}
+    assert sum(r.drops for r in rec.sherds.values()) == 1
+    picked = [rec.sherds[k].pickup_xy for k in (1, 2, 3)]
+    assert picked == [pytest.approx(xy) for xy in ((0.25, 0.30), (0.22, 0.20), (0.11, 0.22))]
+    assert any("grasp turned 90 deg" in n for n in rec.sherds[2].notes)
+    assert batch.unpickable == [] and batch.lost == 0
+    # not turned: grasped again at once, as before (the slip is its own, not its grasp's)
+    world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30), Sherd("c", 0.22, 0.20)])
+    world.slips["a"] = (0.11, 0.22)
+    outcome, batch, rec = _run(config, world)
+    assert rec.sherds[1].pickup_xy == pytest.approx((0.10, 0.22))
+    assert any(n.startswith("recovered: picked up again") for n in rec.sherds[1].notes)
+
+
 def test_a_sherd_that_slips_out_as_often_twice_over_is_left_for_a_person(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
     world.slips["a"] = (0.11, 0.22)
