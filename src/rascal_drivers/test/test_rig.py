@@ -29,6 +29,12 @@ def port_open(port):
         return s.connect_ex(("127.0.0.1", port)) == 0
 
 
+def ignoring_sigint():
+    # as a shell starts a background job (`cmd &`, a CI run): SIGINT ignored, inherited by
+    # every node, and Python then installs no KeyboardInterrupt; Ctrl-C must still stop it all
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def start_rig(tmp_path, env, *sets, port="0"):
     args = ["rosrun", "rascal_drivers", "rig", "--port", port, "--log-dir", str(tmp_path / "log")]
     for item in sets:
@@ -40,6 +46,7 @@ def start_rig(tmp_path, env, *sets, port="0"):
         stderr=subprocess.STDOUT,
         text=True,
         start_new_session=True,
+        preexec_fn=ignoring_sigint,
     )
 
 

@@ -412,6 +412,11 @@ def main(argv=None) -> int:
         stopping["signal"] = signum
         raise KeyboardInterrupt
 
+    # both set here, not left to Python's default: a process started in the background by a
+    # shell (`cmd &`, a CI job) inherits SIGINT ignored, and Python then installs no
+    # KeyboardInterrupt for it, so Ctrl-C would not stop the rig (CI: killed after 60 s, its
+    # nodes left running)
+    signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
     code = 0
     try:

@@ -6,7 +6,10 @@ A KeyboardInterrupt can land between a lock's acquire and the `with` block that 
 close after the loop then waits for ever. In CI a driver that had not exited 10 s after Ctrl-C
 was killed (exit -9) with no torque-off line. The handler here only sets an attribute: it takes
 no lock, so it cannot deadlock with the code it interrupts; every loop it ends sleeps or waits
-at most a fraction of a second between reads of it.
+at most a fraction of a second between reads of it. Installed explicitly, it also works where
+the driver was started with SIGINT ignored (a shell's background job, a CI run): Python then
+installs no KeyboardInterrupt of its own, and Ctrl-C did nothing at all (the likelier cause of
+the CI kills above: the drivers had relied on that default).
 """
 
 import signal
