@@ -7,7 +7,7 @@ import math
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
 from rascal_tasks.rig import Observation
-from rascal_tasks.selection import SLIPPED_HERE, turned
+from rascal_tasks.selection import slipped_here, turned
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.survey import survey_at, survey_pickup_area
 
@@ -94,7 +94,7 @@ class Recover(BatchState):
         if station is not b.pickup or not candidates:
             return self.lose("dropped %d times" % s.drops)
         c = min(candidates, key=lambda c: unlike(s.observation, c, ref))
-        again = any(c.distance_to(x, y) < SLIPPED_HERE for x, y in b.slipped_from)
+        again = slipped_here(c, b.slipped_from)
         b.slipped_from.append((c.x, c.y))
         why = "dropped %d times on its way from the pickup mat" % s.drops
         if again:
@@ -126,7 +126,7 @@ class Recover(BatchState):
             return False
         if not any(c is not it for c in candidates):
             return False  # nothing to take first: nothing will clear its neighbours
-        return not any(it.distance_to(x, y) < SLIPPED_HERE for x, y in b.slipped_from)
+        return not slipped_here(it, b.slipped_from)
 
     def taken_later(self, s: SherdRecord, it: Observation) -> str:
         """`s` (turned_amid_others) left on the mat for after the others: its number goes to

@@ -99,10 +99,18 @@ def in_pick_order(found: List[Observation], policy: str, slipped_from=()) -> Lis
     else:
         ordered = sorted(found, key=lambda o: math.hypot(o.x, o.y))
 
-    def slipped(o):
-        return any(o.distance_to(x, y) < SLIPPED_HERE for x, y in slipped_from)
-
     return sorted(
         ordered,
-        key=lambda o: (o.covered if covered(o) else 0.0, slipped(o), not o.grasp_clear, turned(o)),
+        key=lambda o: (
+            o.covered if covered(o) else 0.0,
+            slipped_here(o, slipped_from),
+            not o.grasp_clear,
+            turned(o),
+        ),
     )
+
+
+def slipped_here(o: Observation, slipped_from) -> bool:
+    """Whether `o` lies within SLIPPED_HERE of a spot of `slipped_from`: the sherd that slipped
+    out there (recovery.Recover), put off for after the others."""
+    return any(o.distance_to(x, y) < SLIPPED_HERE for x, y in slipped_from)
