@@ -25,6 +25,7 @@ from rascal_tasks.survey import (
     taken_off_the_mat,
     view_over,
 )
+from rascal_tasks.selection import lay_under
 
 
 @pytest.fixture
@@ -208,3 +209,33 @@ def test_a_blob_of_several_sherds_seen_apart_since_is_not_asked_back_whole():
     assert not seen_apart(blob, apart[1:2] + apart[3:])
     # a sherd no longer than those seen now was one sherd: asked back as it was
     assert not seen_apart(_seen(0.162, 0.242, 0.060), apart)
+
+
+def test_the_sherd_a_vanished_one_lay_on_does_not_stand_for_it():
+    # heap_25_offcentre seed 70: a 70 x 45 mm sherd (buff) lay on a 57 x 39 mm one (red) 3 cm
+    # from the mat's edge; a grasp beside it flung it off the mat, and the next survey saw the
+    # one it lay on, uncovered, at the same spot: that one is not it seen again
+    buff, red = (0.75, 0.70, 0.60), (0.70, 0.45, 0.33)
+    top = replace(_seen(0.281, 0.207, 0.070), width=0.045, height=0.022, support=0.010, colour=buff)
+    under = replace(_seen(0.270, 0.210, 0.057), width=0.039, height=0.010, colour=red)
+    assert lay_under(under, top)
+
+    def alike(c, o):  # as survey.account_for_vanished asks
+        return c.length >= 0.75 * o.length and not lay_under(c, o)
+
+    b, events = _batch()
+    look_for(b, PUSHED_OFF, [(top.x, top.y, top)], [under], alike, lambda o, r: "")
+    assert events == [PUSHED_OFF]
+    # it slid off onto the mat beside: seen there, itself (its colour), nothing said
+    slid = replace(top, x=0.30, y=0.200, height=0.012, support=0.0)
+    b, events = _batch()
+    look_for(b, PUSHED_OFF, [(top.x, top.y, top)], [under, slid], alike, lambda o, r: "")
+    assert events == []
+    # the one under it of a colour like its own, or no colour told: not surely another sherd
+    assert not lay_under(replace(under, colour=(0.72, 0.68, 0.60)), top)
+    assert not lay_under(replace(under, colour=(0.0, 0.0, 0.0)), top)
+    # one lying higher than what it rested on, or beyond its outline, or a sherd that lay on
+    # nothing: not the one under it
+    assert not lay_under(replace(under, height=0.016), top)
+    assert not lay_under(replace(under, x=0.24), top)
+    assert not lay_under(under, replace(top, support=0.0))

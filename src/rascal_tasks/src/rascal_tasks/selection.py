@@ -27,6 +27,14 @@ SAME_SHERD = 0.02
 # [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
 # another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
 STACKED = 0.002
+# [m] a sherd's top this near the support a sherd lying on it rested on, under its outline, is
+# the one it lay on (the detector's heights come from a depth image of ~1 mm noise at 0.3 m)
+UNDER = 0.003
+# Two mean colours of one sherd differ by less than this in CIELAB a*, b* (its chromaticity:
+# shading, a shadow, a neighbour's reflection change L* more than hue and chroma; wares of the
+# generator's and the field's chips, facts sherds_and_colour.md §2d, 2.5YR 5/6 against
+# 10YR 7/3, differ by ~25).
+UNLIKE_COLOUR = 15.0
 
 
 def same_size(a, b) -> bool:
@@ -34,6 +42,40 @@ def same_size(a, b) -> bool:
     return abs(a.length - b.length) <= SAME_SIZE * b.length and abs(
         a.width - b.width
     ) <= SAME_SIZE * max(b.width, 0.5 * b.length)
+
+
+def chromaticity(rgb):
+    """CIELAB (a*, b*) of an sRGB colour in [0, 1] (OpenCV's conversion, D65); None when not
+    told (black, the Observation's default)."""
+    if not any(rgb):
+        return None
+    import cv2  # a task-layer test without OpenCV never compares colours
+    import numpy as np
+
+    lab = cv2.cvtColor(np.array([[rgb]], dtype=np.float32), cv2.COLOR_RGB2Lab)[0, 0]
+    return float(lab[1]), float(lab[2])
+
+
+def unlike_in_colour(a, b) -> bool:
+    """Whether `a` and `b` (Observations) are surely two sherds by their mean colours: their
+    chromaticities apart by more than UNLIKE_COLOUR. Alike, or either not told: not surely."""
+    ca, cb = chromaticity(a.colour), chromaticity(b.colour)
+    return ca is not None and cb is not None and math.dist(ca, cb) > UNLIKE_COLOUR
+
+
+def lay_under(c, o: Observation) -> bool:
+    """Whether `c`, seen now, is the sherd `o` (of an earlier survey) lay on, uncovered since:
+    `o` rested on something (its support above STACKED), `c` lies under `o`'s outline with its
+    top no higher than that support, and its colour is another sherd's. Such a `c` cannot stand
+    for `o` seen again (heap_25_offcentre seed 70: a 70 mm sherd lying on a 57 mm one was flung
+    off the mat; the one under it, at the same spot, counted as it seen again and nothing was
+    said)."""
+    return (
+        o.support > STACKED
+        and c.distance_to(o.x, o.y) < o.length / 2
+        and c.height <= o.support + UNDER
+        and unlike_in_colour(c, o)
+    )
 
 
 def itself(p, o: Observation) -> bool:

@@ -10,7 +10,14 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.batch import PUSHED_OFF, SLIPPED_AWAY, BatchState, NotSeenAgain
 from rascal_tasks.rig import Leftover, Observation
-from rascal_tasks.selection import SAME_SHERD, SAME_SIZE, covered, in_pick_order, same_size
+from rascal_tasks.selection import (
+    SAME_SHERD,
+    SAME_SIZE,
+    covered,
+    in_pick_order,
+    lay_under,
+    same_size,
+)
 from rascal_tasks.singulation import lay_flat
 
 # Wrist camera offset from ee_gripper_link when the gripper points down, along the gripper's
@@ -215,7 +222,8 @@ def account_for_vanished(b, found: List[Observation]):
     off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
     seen again: a sherd at least about as long within recovery.search_radius of where it lay
     (a neighbour's grasp may nudge it; in a heap a sherd uncovered since shows more of itself,
-    and smaller ones always lie near), or anything perception does not offer. One not seen
+    and smaller ones always lie near) but not the one it lay on (selection.lay_under), or anything
+    perception does not offer. One not seen
     may have been pushed off the mat by a grasp beside it: said, and the batch ends
     incomplete (a sherd recorded nowhere and said nowhere is the one failure a person would
     never notice)."""
@@ -232,7 +240,8 @@ def account_for_vanished(b, found: List[Observation]):
         PUSHED_OFF,
         near,
         found,
-        lambda c, o: isinstance(c, Leftover) or c.length >= (1.0 - SAME_SIZE) * o.length,
+        lambda c, o: isinstance(c, Leftover)
+        or (c.length >= (1.0 - SAME_SIZE) * o.length and not lay_under(c, o)),
         lambda o, radius: "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge "
         "was not picked up and is not seen within %.0f mm of there since: a grasp beside it may "
         "have pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
