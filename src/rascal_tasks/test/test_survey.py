@@ -239,3 +239,5 @@ def test_the_sherd_a_vanished_one_lay_on_does_not_stand_for_it():
     assert not lay_under(replace(under, height=0.016), top)
     assert not lay_under(replace(under, x=0.24), top)
     assert not lay_under(under, replace(top, support=0.0))
+    # itself seen again at its height, its mean colour changed (a neighbour gone, a shadow)
+    assert not lay_under(replace(top, colour=red), top)

@@ -66,14 +66,15 @@ def unlike_in_colour(a, b) -> bool:
 def lay_under(c, o: Observation) -> bool:
     """Whether `c`, seen now, is the sherd `o` (of an earlier survey) lay on, uncovered since:
     `o` rested on something (its support above STACKED), `c` lies under `o`'s outline with its
-    top no higher than that support, and its colour is another sherd's. Such a `c` cannot stand
+    top no higher than that support (nor halfway up `o`: `o` itself seen again stands higher),
+    and its colour is another sherd's. Such a `c` cannot stand
     for `o` seen again (heap_25_offcentre seed 70: a 70 mm sherd lying on a 57 mm one was flung
     off the mat; the one under it, at the same spot, counted as it seen again and nothing was
     said)."""
     return (
         o.support > STACKED
         and c.distance_to(o.x, o.y) < o.length / 2
-        and c.height <= o.support + UNDER
+        and c.height <= min(o.support + UNDER, (o.support + o.height) / 2)
         and unlike_in_colour(c, o)
     )
 

@@ -217,6 +217,32 @@ def seen_apart(o: Observation, found: List[Observation]) -> bool:
     )
 
 
+def _lay_under(b, c, o: Observation) -> bool:
+    """selection.lay_under, logged: which sherd seen was not taken for which (each pair once)."""
+    if not lay_under(c, o):
+        return False
+    said = b.__dict__.setdefault("_said_under", set())
+    if (id(c), id(o)) not in said:
+        said.add((id(c), id(o)))
+        b.log(
+            "survey: the %.0f x %.0f mm sherd at (%.3f, %.3f) m, top %.1f mm, is the one the "
+            "%.0f x %.0f mm sherd seen at (%.3f, %.3f) m lay on (%.1f mm), not it"
+            % (
+                c.length * 1e3,
+                c.width * 1e3,
+                c.x,
+                c.y,
+                c.height * 1e3,
+                o.length * 1e3,
+                o.width * 1e3,
+                o.x,
+                o.y,
+                o.support * 1e3,
+            )
+        )
+    return True
+
+
 def account_for_vanished(b, found: List[Observation]):
     """Each sherd of the survey before (`b.seen`) lying near the mat's edge that was not taken
     off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
@@ -241,7 +267,7 @@ def account_for_vanished(b, found: List[Observation]):
         near,
         found,
         lambda c, o: isinstance(c, Leftover)
-        or (c.length >= (1.0 - SAME_SIZE) * o.length and not lay_under(c, o)),
+        or (c.length >= (1.0 - SAME_SIZE) * o.length and not _lay_under(b, c, o)),
         lambda o, radius: "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge "
         "was not picked up and is not seen within %.0f mm of there since: a grasp beside it may "
         "have pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
