@@ -27,9 +27,6 @@ SAME_SHERD = 0.02
 # [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
 # another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
 STACKED = 0.002
-# [m] a sherd's top this near the support a sherd lying on it rested on, under its outline, is
-# the one it lay on (the detector's heights come from a depth image of ~1 mm noise at 0.3 m)
-UNDER = 0.003
 # Two mean colours of one sherd differ by less than this in CIELAB a*, b* (its chromaticity:
 # shading, a shadow, a neighbour's reflection change L* more than hue and chroma; wares of the
 # generator's and the field's chips, facts sherds_and_colour.md §2d, 2.5YR 5/6 against
@@ -63,20 +60,14 @@ def unlike_in_colour(a, b) -> bool:
     return ca is not None and cb is not None and math.dist(ca, cb) > UNLIKE_COLOUR
 
 
-def lay_under(c, o: Observation) -> bool:
-    """Whether `c`, seen now, is the sherd `o` (of an earlier survey) lay on, uncovered since:
-    `o` rested on something (its support above STACKED), `c` lies under `o`'s outline with its
-    top no higher than that support (nor halfway up `o`: `o` itself seen again stands higher),
-    and its colour is another sherd's. Such a `c` cannot stand
-    for `o` seen again (heap_25_offcentre seed 70: a 70 mm sherd lying on a 57 mm one was flung
-    off the mat; the one under it, at the same spot, counted as it seen again and nothing was
-    said)."""
-    return (
-        o.support > STACKED
-        and c.distance_to(o.x, o.y) < o.length / 2
-        and c.height <= min(o.support + UNDER, (o.support + o.height) / 2)
-        and unlike_in_colour(c, o)
-    )
+def surely_another(c, o: Observation) -> bool:
+    """Whether `c`, seen now, is surely not `o` (of an earlier survey) moved or uncovered since:
+    unlike in colour, however near and alike in size. A sherd nudged, slid off the one it lay
+    on or uncovered shows more or less of itself, in shade or shadow, but not another hue and
+    chroma; the one it hid is the sherd most often found where it lay, often of its size (heap_25_offcentre seed 70 and heap_20 seed 62: a
+    sherd lying on another was flung off the mat by a grasp beside it, the one under it, of
+    its size and at its spot, counted as it seen again, and nothing was said)."""
+    return c is not o and unlike_in_colour(c, o)
 
 
 def itself(p, o: Observation) -> bool:

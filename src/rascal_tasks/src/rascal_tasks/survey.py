@@ -15,7 +15,7 @@ from rascal_tasks.selection import (
     SAME_SIZE,
     covered,
     in_pick_order,
-    lay_under,
+    surely_another,
     same_size,
 )
 from rascal_tasks.singulation import lay_flat
@@ -217,28 +217,18 @@ def seen_apart(o: Observation, found: List[Observation]) -> bool:
     )
 
 
-def _lay_under(b, c, o: Observation) -> bool:
-    """selection.lay_under, logged: which sherd seen was not taken for which (each pair once)."""
-    if not lay_under(c, o):
+def _surely_another(b, c, o: Observation) -> bool:
+    """selection.surely_another, logged: which sherd seen was not taken for which (each pair
+    once a survey)."""
+    if not surely_another(c, o):
         return False
-    said = b.__dict__.setdefault("_said_under", set())
+    said = b.__dict__.setdefault("_said_another", set())
     if (id(c), id(o)) not in said:
         said.add((id(c), id(o)))
         b.log(
-            "survey: the %.0f x %.0f mm sherd at (%.3f, %.3f) m, top %.1f mm, is the one the "
-            "%.0f x %.0f mm sherd seen at (%.3f, %.3f) m lay on (%.1f mm), not it"
-            % (
-                c.length * 1e3,
-                c.width * 1e3,
-                c.x,
-                c.y,
-                c.height * 1e3,
-                o.length * 1e3,
-                o.width * 1e3,
-                o.x,
-                o.y,
-                o.support * 1e3,
-            )
+            "survey: the %.0f x %.0f mm sherd at (%.3f, %.3f) m is another colour than the "
+            "%.0f x %.0f mm one seen at (%.3f, %.3f) m: not it seen again"
+            % (c.length * 1e3, c.width * 1e3, c.x, c.y, o.length * 1e3, o.width * 1e3, o.x, o.y)
         )
     return True
 
@@ -248,8 +238,8 @@ def account_for_vanished(b, found: List[Observation]):
     off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
     seen again: a sherd at least about as long within recovery.search_radius of where it lay
     (a neighbour's grasp may nudge it; in a heap a sherd uncovered since shows more of itself,
-    and smaller ones always lie near) but not the one it lay on (selection.lay_under), or anything
-    perception does not offer. One not seen
+    and smaller ones always lie near) but not one of another colour (selection.surely_another),
+    or anything perception does not offer. One not seen
     may have been pushed off the mat by a grasp beside it: said, and the batch ends
     incomplete (a sherd recorded nowhere and said nowhere is the one failure a person would
     never notice)."""
@@ -267,7 +257,7 @@ def account_for_vanished(b, found: List[Observation]):
         near,
         found,
         lambda c, o: isinstance(c, Leftover)
-        or (c.length >= (1.0 - SAME_SIZE) * o.length and not _lay_under(b, c, o)),
+        or (c.length >= (1.0 - SAME_SIZE) * o.length and not _surely_another(b, c, o)),
         lambda o, radius: "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge "
         "was not picked up and is not seen within %.0f mm of there since: a grasp beside it may "
         "have pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
