@@ -64,9 +64,10 @@ def surely_another(c, o: Observation) -> bool:
     """Whether `c`, seen now, is surely not `o` (of an earlier survey) moved or uncovered since:
     unlike in colour, however near and alike in size. A sherd nudged, slid off the one it lay
     on or uncovered shows more or less of itself, in shade or shadow, but not another hue and
-    chroma; the one it hid is the sherd most often found where it lay, often of its size (heap_25_offcentre seed 70 and heap_20 seed 62: a
-    sherd lying on another was flung off the mat by a grasp beside it, the one under it, of
-    its size and at its spot, counted as it seen again, and nothing was said)."""
+    chroma; the one it hid is the sherd most often found where it lay, often of its size
+    (heap_25_offcentre seed 70 and heap_20 seed 62: a sherd lying on another was flung off the
+    mat by a grasp beside it, the one under it, of its size and at its spot, counted as it seen
+    again, and nothing was said)."""
     return c is not o and unlike_in_colour(c, o)
 
 
