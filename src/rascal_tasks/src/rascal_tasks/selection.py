@@ -43,7 +43,7 @@ def same_size(a, b) -> bool:
 
 def chromaticity(rgb):
     """CIELAB (a*, b*) of an sRGB colour in [0, 1] (OpenCV's conversion, D65); None when not
-    told (black, the Observation's default)."""
+    told (black, the Observation's default; or none)."""
     if not any(rgb):
         return None
     import cv2  # a task-layer test without OpenCV never compares colours
@@ -56,7 +56,8 @@ def chromaticity(rgb):
 def unlike_in_colour(a, b) -> bool:
     """Whether `a` and `b` (Observations) are surely two sherds by their mean colours: their
     chromaticities apart by more than UNLIKE_COLOUR. Alike, or either not told: not surely."""
-    ca, cb = chromaticity(a.colour), chromaticity(b.colour)
+    # a Leftover (rig.py) carries no colour
+    ca, cb = chromaticity(getattr(a, "colour", ())), chromaticity(getattr(b, "colour", ()))
     return ca is not None and cb is not None and math.dist(ca, cb) > UNLIKE_COLOUR
 
 

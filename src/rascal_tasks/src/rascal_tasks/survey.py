@@ -155,14 +155,15 @@ def _several(c, o: Observation) -> bool:
 def account_for_slips(b, found: List[Observation]):
     """Sherds that slipped out of the fingers while lifted (pickup.py) have no number yet, so
     no row would miss one. Each must be seen again by the survey after it: a sherd of its size
-    within recovery.search_radius of where it was held (others always lie near in a heap).
+    within recovery.search_radius of where it was held (others always lie near in a heap), not
+    of another colour (selection.surely_another).
     One not seen may lie beside the mat: said, and the batch ends incomplete."""
     look_for(
         b,
         SLIPPED_AWAY,
         [(o.grasp_x, o.grasp_y, o) for o in b.unchecked_slips],
         found,
-        same_size,
+        lambda c, o: same_size(c, o) and not _surely_another(b, c, o),
         lambda o, radius: "a %.0f x %.0f mm sherd slipped out of the fingers while lifted at "
         "(%.3f, %.3f) m and the survey after it sees none of its size within %.0f mm of there: "
         "it may lie beside the mat"
