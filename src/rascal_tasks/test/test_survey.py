@@ -236,5 +236,8 @@ def test_a_sherd_of_another_colour_does_not_stand_for_one_not_seen_again():
     assert not surely_another(replace(under, colour=(0.72, 0.68, 0.60)), top)
     assert not surely_another(replace(under, colour=(0.0, 0.0, 0.0)), top)
     assert not surely_another(Leftover(0.27, 0.21, 0.06, 0.04, "too large"), top)
+    # seen partly under another sherd, its mean colour takes in that one's shadow and edge
+    assert not surely_another(under, replace(top, covered=0.3))
+    assert not surely_another(replace(under, covered=0.3), top)
     # itself seen again where it lay, in a neighbour's shadow (darker, of its hue)
     assert not surely_another(replace(top, x=0.285, colour=(0.56, 0.52, 0.44)), top)

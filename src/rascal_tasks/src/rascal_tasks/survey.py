@@ -13,6 +13,7 @@ from rascal_tasks.rig import Leftover, Observation
 from rascal_tasks.selection import (
     SAME_SHERD,
     SAME_SIZE,
+    colour_difference,
     covered,
     in_pick_order,
     surely_another,
@@ -227,9 +228,19 @@ def _surely_another(b, c, o: Observation) -> bool:
     if (id(c), id(o)) not in said:
         said.add((id(c), id(o)))
         b.log(
-            "survey: the %.0f x %.0f mm sherd at (%.3f, %.3f) m is another colour than the "
-            "%.0f x %.0f mm one seen at (%.3f, %.3f) m: not it seen again"
-            % (c.length * 1e3, c.width * 1e3, c.x, c.y, o.length * 1e3, o.width * 1e3, o.x, o.y)
+            "survey: the %.0f x %.0f mm sherd at (%.3f, %.3f) m is another colour (%.0f apart "
+            "in a*, b*) than the %.0f x %.0f mm one seen at (%.3f, %.3f) m: not it seen again"
+            % (
+                c.length * 1e3,
+                c.width * 1e3,
+                c.x,
+                c.y,
+                colour_difference(c, o),
+                o.length * 1e3,
+                o.width * 1e3,
+                o.x,
+                o.y,
+            )
         )
     return True
 
