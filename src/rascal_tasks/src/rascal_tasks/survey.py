@@ -221,7 +221,7 @@ def seen_apart(o: Observation, found: List[Observation]) -> bool:
 
 def _surely_another(b, c, o: Observation) -> bool:
     """selection.surely_another, logged: which sherd seen was not taken for which (each pair
-    once a survey)."""
+    once a batch: look_for asks each pair more than once)."""
     if not surely_another(c, o):
         return False
     said = b.__dict__.setdefault("_said_another", set())
