@@ -240,3 +240,28 @@ def test_the_fingertip_pads_layout_passes_with_the_shipped_one_station_layout_to
         cfg = load_config(SHIPPED, over=over)
         assert cfg["arm"]["gripper"]["fingertip_pads"] == 0.0075
     assert load_config(SHIPPED)["arm"]["gripper"]["fingertip_pads"] == 0.0
+
+
+def test_a_turned_station_turns_its_area_and_what_stands_on_it(shipped):
+    """`stations.<name>.yaw`: the pickup mat turned 5° keeps its centre; its corners, what lies
+    on it and the survey's views turn with it, and its markers' offsets are in its frame."""
+    import math
+
+    from rascal_tasks.config import Rect
+
+    data = copy.deepcopy(shipped)
+    yaw = math.radians(5.0)
+    data["stations"]["pickup"]["yaw"] = yaw
+    mat = config_from_dict(data).stations["pickup"].area
+    square = config_from_dict(shipped).stations["pickup"].area
+    assert mat.center == square.center and mat.yaw == pytest.approx(yaw)
+    hx, hy = square.size[0] / 2, square.size[1] / 2
+    corner = (square.center[0] + hx - 0.002, square.center[1] + hy - 0.002)
+    assert square.has(corner) and not mat.has(corner)  # off the turned mat
+    assert mat.has(mat.to_table((hx - 0.002, hy - 0.002)))
+    assert all(mat.has(v) for v in mat.lawnmower(data["survey"]["step"]))
+    assert Rect((0.0, 0.0), (0.1, 0.1), math.radians(45)).overlaps(Rect((0.075, 0.0), (0.02, 0.02)))
+    assert not Rect((0.0, 0.0), (0.1, 0.1)).overlaps(Rect((0.075, 0.0), (0.02, 0.1)))
+    data["stations"]["pickup"]["yaw"] = 1.0
+    with pytest.raises(ConfigError, match=r"stations\.pickup\.yaw"):
+        config_from_dict(data)

@@ -1,3 +1,4 @@
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <map>
@@ -72,20 +73,25 @@ TEST(StationMarker, NoneConfiguredNoneDrawn) {
   EXPECT_TRUE(sim.world().layout().markers.empty());
 }
 
-TEST(StationMarker, AnOffsetMovesTheStationAndTurnsOnlyItsMarkers) {
+TEST(StationMarker, AnOffsetMovesAndTurnsTheStationWithEverythingOnIt) {
   WorldLayout l = read(withPickupMarkers()).layout;
   const WorldLayout configured = l;
   const Station& discard = configured.station(StationType::Discard);
   l.offsetStation(discard.name, 0.03, -0.02, 0.1);
   const Eigen::Vector2d shift(0.03, -0.02);
-  EXPECT_TRUE(l.station(StationType::Discard).area.centre.isApprox(discard.area.centre + shift));
-  EXPECT_TRUE(l.station(StationType::Discard).place_at.isApprox(discard.place_at + shift));
+  const Eigen::Rotation2Dd turn(0.1);
+  const Station& moved_discard = l.station(StationType::Discard);
+  EXPECT_TRUE(moved_discard.area.centre.isApprox(discard.area.centre + shift));
+  EXPECT_NEAR(moved_discard.area.yaw, 0.1, 1e-12);
+  EXPECT_TRUE(moved_discard.place_at.isApprox(discard.place_at + shift));
   for (size_t i = 0; i < l.boxes.size(); ++i) {
-    const Eigen::Vector3d moved = l.boxes[i].centre - configured.boxes[i].centre;
     const bool of_discard = l.boxes[i].station == discard.name;
-    EXPECT_TRUE(moved.isApprox(of_discard ? Eigen::Vector3d(0.03, -0.02, 0.0) : Eigen::Vector3d::Zero()))
-        << l.boxes[i].name;
-    EXPECT_EQ(l.boxes[i].size, configured.boxes[i].size) << l.boxes[i].name;  // still axis-aligned
+    const Eigen::Vector2d was = configured.boxes[i].centre.head<2>();
+    const Eigen::Vector2d expected =
+        of_discard ? Eigen::Vector2d(discard.area.centre + shift + turn * (was - discard.area.centre)) : was;
+    EXPECT_LT((l.boxes[i].centre.head<2>() - expected).norm(), 1e-12) << l.boxes[i].name;
+    EXPECT_NEAR(l.boxes[i].yaw, of_discard ? 0.1 : 0.0, 1e-12) << l.boxes[i].name;
+    EXPECT_EQ(l.boxes[i].size, configured.boxes[i].size) << l.boxes[i].name;
   }
   EXPECT_EQ(l.workcell.station(StationType::Discard).area.centre, discard.area.centre);  // as configured
   EXPECT_EQ(l.markers[0].centre, configured.markers[0].centre);  // pickup's markers stay

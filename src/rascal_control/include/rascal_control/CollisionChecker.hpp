@@ -28,6 +28,7 @@ struct Fixture {
   bool support = false;
   // Arm links allowed to touch it (the arm's own base: the links mounted on it).
   std::set<std::string> allowed;
+  double yaw = 0.0;    // [rad] about +z: the box turns with its station
 };
 
 class CollisionChecker {

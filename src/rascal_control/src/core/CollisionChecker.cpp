@@ -114,7 +114,7 @@ void CollisionChecker::addFixture(const Fixture& fixture) {
   fixtures_.push_back(fixture);
   auto object = std::make_shared<fcl::CollisionObjectd>(
       std::make_shared<fcl::Boxd>(fixture.size.x(), fixture.size.y(), fixture.size.z()));
-  object->setTransform(toFcl(KDL::Frame(fixture.centre)));
+  object->setTransform(toFcl(KDL::Frame(KDL::Rotation::RotZ(fixture.yaw), fixture.centre)));
   object->computeAABB();
   fixture_objects_.push_back(object);
 }
@@ -122,7 +122,7 @@ void CollisionChecker::addFixture(const Fixture& fixture) {
 void CollisionChecker::addFixtures(const std::vector<rascal_workcell::FixtureBox>& boxes) {
   for (const rascal_workcell::FixtureBox& b : boxes) {
     addFixture({b.name, KDL::Vector(b.centre.x(), b.centre.y(), b.centre.z()),
-                KDL::Vector(b.size.x(), b.size.y(), b.size.z()), b.is_support, {}});
+                KDL::Vector(b.size.x(), b.size.y(), b.size.z()), b.is_support, {}, b.yaw});
   }
 }
 

@@ -46,6 +46,7 @@ std::string layoutKey(const rascal_workcell::Station& s) {
     k << " " << r->centre.x() << " " << r->centre.y() << " " << r->size.x() << " " << r->size.y();
   }
   k << " " << s.place_at.x() << " " << s.place_at.y();
+  if (s.area.yaw != 0.0) k << " yaw " << s.area.yaw;  // keys of square stations as before
   return k.str();
 }
 

@@ -17,10 +17,13 @@ struct Mesh {
   void updateBounds();
 
   void addTriangle(int a, int b, int c, const Eigen::Vector3f& linear_rgb);
-  /// Adds an axis-aligned box (centre, size) with one sRGB colour.
-  void addBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size, const Eigen::Vector3d& srgb);
-  /// Adds a flat rectangle at height z (centre x, y; size x, y) with one sRGB colour.
-  void addRect(double cx, double cy, double sx, double sy, double z, const Eigen::Vector3d& srgb);
+  /// Adds a box (centre, size along its own axes, turned by yaw [rad] about +z) with one sRGB colour.
+  void addBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size, const Eigen::Vector3d& srgb,
+              double yaw = 0.0);
+  /// Adds a flat rectangle at height z (centre x, y; size x, y along its own axes, turned by yaw
+  /// [rad] about +z) with one sRGB colour.
+  void addRect(double cx, double cy, double sx, double sy, double z, const Eigen::Vector3d& srgb,
+               double yaw = 0.0);
   /// Adds a flat quadrilateral a, b, c, d (counter-clockwise seen from its front) with one sRGB colour.
   void addQuad(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                const Eigen::Vector3d& d, const Eigen::Vector3d& srgb);

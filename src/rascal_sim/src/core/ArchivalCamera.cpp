@@ -1,5 +1,6 @@
 #include "rascal_sim/ArchivalCamera.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 
 namespace rascal_sim {
@@ -16,11 +17,11 @@ ArchivalCamera::ArchivalCamera(const WorldLayout& layout, int width, int height)
   model_.cy = height / 2.0;
   model_.near = 0.02;
   model_.far = 2.0;
-  // straight down: image x = world +x, image y = world -y
+  // straight down: image x = the station's +x, image y = its -y (the camera turns with its stand)
   world_T_camera_ = Eigen::Isometry3d::Identity();
   Eigen::Matrix3d r;
   r << 1, 0, 0, 0, -1, 0, 0, 0, -1;
-  world_T_camera_.linear() = r;
+  world_T_camera_.linear() = Eigen::AngleAxisd(station.area.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * r;
   world_T_camera_.translation() = Eigen::Vector3d(station.area.centre.x(), station.area.centre.y(), h);
 }
 

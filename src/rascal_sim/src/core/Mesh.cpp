@@ -26,11 +26,12 @@ void Mesh::addTriangle(int a, int b, int c, const Eigen::Vector3f& linear_rgb) {
 }
 
 void Mesh::addBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size,
-                  const Eigen::Vector3d& srgb) {
+                  const Eigen::Vector3d& srgb, double yaw) {
   const int base = static_cast<int>(vertices.size());
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   for (int i = 0; i < 8; ++i) {
     Eigen::Vector3d c((i & 1) ? 0.5 : -0.5, (i & 2) ? 0.5 : -0.5, (i & 4) ? 0.5 : -0.5);
-    vertices.push_back(centre + c.cwiseProduct(size));
+    vertices.push_back(centre + turn * c.cwiseProduct(size));
   }
   const Eigen::Vector3f lin = srgbToLinear(srgb);
   static const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
@@ -42,9 +43,13 @@ void Mesh::addBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size,
 }
 
 void Mesh::addRect(double cx, double cy, double sx, double sy, double z,
-                   const Eigen::Vector3d& srgb) {
-  addQuad({cx - sx / 2, cy - sy / 2, z}, {cx + sx / 2, cy - sy / 2, z}, {cx + sx / 2, cy + sy / 2, z},
-          {cx - sx / 2, cy + sy / 2, z}, srgb);
+                   const Eigen::Vector3d& srgb, double yaw) {
+  const Eigen::Rotation2Dd turn(yaw);
+  auto at = [&](double lx, double ly) {
+    const Eigen::Vector2d p = Eigen::Vector2d(cx, cy) + turn * Eigen::Vector2d(lx, ly);
+    return Eigen::Vector3d(p.x(), p.y(), z);
+  };
+  addQuad(at(-sx / 2, -sy / 2), at(sx / 2, -sy / 2), at(sx / 2, sy / 2), at(-sx / 2, sy / 2), srgb);
 }
 
 void Mesh::addQuad(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,

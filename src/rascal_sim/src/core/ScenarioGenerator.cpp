@@ -139,12 +139,13 @@ std::vector<SherdSpec> ScenarioGenerator::generate(const GeneratorOptions& o) co
     yaw += jitter + ((rng() % 2) ? kPi : 0.0);
     const Eigen::Vector2d ext = turnedExtents(length, width, yaw);
     const int r = i / cols, c = i % cols;
-    Eigen::Vector2d centre(o.area.centre.x() - o.area.size.x() / 2 + (c + 0.5) * cell.x(),
-                           o.area.centre.y() - o.area.size.y() / 2 + (r + 0.5) * cell.y());
+    // in the mat's own frame (a turned mat turns its grid)
+    Eigen::Vector2d centre(-o.area.size.x() / 2 + (c + 0.5) * cell.x(), -o.area.size.y() / 2 + (r + 0.5) * cell.y());
     const Eigen::Vector2d slack = (cell - ext - Eigen::Vector2d::Constant(o.min_spacing)).cwiseMax(0.0);
     centre.x() += uniform(rng, -slack.x() / 2, slack.x() / 2 + 1e-12);
     centre.y() += uniform(rng, -slack.y() / 2, slack.y() / 2 + 1e-12);
-    s.pose = Eigen::Vector3d(centre.x(), centre.y(), std::remainder(yaw, 2 * kPi));
+    const Eigen::Vector2d at = o.area.toTable(centre);
+    s.pose = Eigen::Vector3d(at.x(), at.y(), std::remainder(yaw + o.area.yaw, 2 * kPi));
     extents[i] = Eigen::Vector2d(length, width);
     out.push_back(s);
   }
@@ -188,12 +189,12 @@ void ScenarioGenerator::heapUp(std::vector<SherdSpec>& sherds, const std::vector
     double spread = o.heap_spread;
     for (int attempt = 0;; ++attempt) {
       std::normal_distribution<double> scatter(0.0, spread);
-      const double yaw = uniform(rng, -kPi, kPi);
+      const double yaw = uniform(rng, -kPi, kPi);  // in the mat's own frame, as lo and hi
       const Eigen::Vector2d half = turnedExtents(extents[i].x(), extents[i].y(), yaw) / 2;
-      const Eigen::Vector2d lo = o.area.centre - o.area.size / 2 + half;
-      const Eigen::Vector2d hi = o.area.centre + o.area.size / 2 - half;
-      const Eigen::Vector2d c = (o.heap_centre + Eigen::Vector2d(scatter(rng), scatter(rng))).cwiseMax(lo).cwiseMin(hi);
-      s.pose = Eigen::Vector3d(c.x(), c.y(), yaw);
+      const Eigen::Vector2d lo = -o.area.size / 2 + half, hi = o.area.size / 2 - half;
+      const Eigen::Vector2d scattered = o.area.toLocal(o.heap_centre) + Eigen::Vector2d(scatter(rng), scatter(rng));
+      const Eigen::Vector2d c = o.area.toTable(scattered.cwiseMax(lo).cwiseMin(hi));
+      s.pose = Eigen::Vector3d(c.x(), c.y(), yaw + o.area.yaw);
       double under = 0.0;
       int depth = 1;
       for (size_t j = 0; j < i; ++j) {

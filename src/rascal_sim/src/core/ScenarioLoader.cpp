@@ -59,7 +59,10 @@ TableRect station(const WorldLayout& l, const std::map<std::string, StationOffse
   const Station& s = l.station(t);
   TableRect area = s.area;
   const auto o = offsets.find(s.name);
-  if (o != offsets.end()) area.centre += Eigen::Vector2d(o->second.dx, o->second.dy);
+  if (o != offsets.end()) {
+    area.centre += Eigen::Vector2d(o->second.dx, o->second.dy);
+    area.yaw += o->second.dyaw;
+  }
   return area;
 }
 

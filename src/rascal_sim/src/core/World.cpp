@@ -24,12 +24,14 @@ constexpr double kPlatformMass = 0.30;  // [kg] the weighing pan (tared away)
 /// thickness has the rest of its platform below the table top, where nothing collides with it.
 struct PlatformBox {
   Eigen::Vector3d centre, size;
+  double yaw;
 };
 
 PlatformBox platformBox(const Station& scale) {
   const double t = Workcell::kScalePlatformThickness;
   return {{scale.area.centre.x(), scale.area.centre.y(), scale.surface_z - t / 2},
-          {scale.area.size.x(), scale.area.size.y(), t}};
+          {scale.area.size.x(), scale.area.size.y(), t},
+          scale.area.yaw};
 }
 
 /// Colour of a fixture box, by the type of the station it belongs to.
@@ -115,9 +117,12 @@ struct World::Impl {
     return &tags.back();
   }
 
-  void staticBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size) {
+  void staticBox(const Eigen::Vector3d& centre, const Eigen::Vector3d& size, double yaw) {
     dGeomID g = dCreateBox(space, size.x(), size.y(), size.z());
     dGeomSetPosition(g, centre.x(), centre.y(), centre.z());
+    dMatrix3 r;
+    dRFromAxisAndAngle(r, 0, 0, 1, yaw);
+    dGeomSetRotation(g, r);
     dGeomSetData(g, tag(GeomTag::kStatic, 0));
   }
 
@@ -191,32 +196,33 @@ struct World::Impl {
     const double mz = 0.0004;
     for (const Station& s : l.stations) {
       if (s.type == StationType::Pickup || s.type == StationType::Discard || s.type == StationType::Bin) {
-        m.addRect(s.area.centre.x(), s.area.centre.y(), s.area.size.x(), s.area.size.y(), mz, l.mat_colour);
+        m.addRect(s.area.centre.x(), s.area.centre.y(), s.area.size.x(), s.area.size.y(), mz, l.mat_colour,
+                  s.area.yaw);
       }
     }
     // fixtures standing on the table: scale housing, camera stand post, discard box walls
     for (const FixtureBox& b : boxes) {
-      if (!isPlatform(l, b)) m.addBox(b.centre, b.size, fixtureColour(l, b));
+      if (!isPlatform(l, b)) m.addBox(b.centre, b.size, fixtureColour(l, b), b.yaw);
     }
     // scale platform: dark rim, light pan
     const Station& scale = l.station(StationType::Scale);
     const PlatformBox pb = platformBox(scale);
-    m.addBox(pb.centre, pb.size, l.scale_colours[1]);
+    m.addBox(pb.centre, pb.size, l.scale_colours[1], pb.yaw);
     if ((scale.area.size.array() > 0.02).all()) {
       m.addRect(pb.centre.x(), pb.centre.y(), scale.area.size.x() - 0.02, scale.area.size.y() - 0.02,
-                scale.surface_z + 0.0003, l.scale_colours[0]);
+                scale.surface_z + 0.0003, l.scale_colours[0], pb.yaw);
     }
     // colour chart: black card with 4 x 6 patches, row 1 at +y
     const Station& camera = l.station(StationType::ArchivalCamera);
     const TableRect& cc = camera.colour_chart;
-    m.addRect(cc.centre.x(), cc.centre.y(), cc.size.x(), cc.size.y(), 0.0008, {0.05, 0.05, 0.05});
+    m.addRect(cc.centre.x(), cc.centre.y(), cc.size.x(), cc.size.y(), 0.0008, {0.05, 0.05, 0.05}, cc.yaw);
     const auto patches = MunsellTable::readColourChecker(l.data_dir + "/colorchecker24_xrite_after2014_D50.csv");
     const double pw = cc.size.x() / 6, ph = cc.size.y() / 4;
     for (int r = 0; r < 4; ++r) {
       for (int c = 0; c < 6; ++c) {
-        const double x = cc.centre.x() - cc.size.x() / 2 + (c + 0.5) * pw;
-        const double y = cc.centre.y() + cc.size.y() / 2 - (r + 0.5) * ph;
-        m.addRect(x, y, pw * 0.8, ph * 0.8, 0.0012, patches[r * 6 + c]);
+        const Eigen::Vector2d p =
+            cc.toTable({-cc.size.x() / 2 + (c + 0.5) * pw, cc.size.y() / 2 - (r + 0.5) * ph});
+        m.addRect(p.x(), p.y(), pw * 0.8, ph * 0.8, 0.0012, patches[r * 6 + c], cc.yaw);
       }
     }
     // scale bar: 10 cm, two rows; -x half a 1 cm chequer, +x half black over white
@@ -224,18 +230,20 @@ struct World::Impl {
     const double row = sb.size.y() / 2, cell = sb.size.x() / 10;
     for (int i = 0; i < 10; ++i) {
       for (int r = 0; r < 2; ++r) {
-        const double x = sb.centre.x() - sb.size.x() / 2 + (i + 0.5) * cell;
-        const double y = sb.centre.y() + (r == 0 ? row / 2 : -row / 2);
+        const Eigen::Vector2d p = sb.toTable({-sb.size.x() / 2 + (i + 0.5) * cell, r == 0 ? row / 2 : -row / 2});
         const bool black = i < 5 ? ((i + r) % 2 == 0) : (r == 0);
-        m.addRect(x, y, cell, row, 0.0008, black ? Eigen::Vector3d(0.04, 0.04, 0.04) : Eigen::Vector3d(0.95, 0.95, 0.95));
+        m.addRect(p.x(), p.y(), cell, row, 0.0008,
+                  black ? Eigen::Vector3d(0.04, 0.04, 0.04) : Eigen::Vector3d(0.95, 0.95, 0.95), sb.yaw);
       }
     }
     // camera stand: boom from the post and camera body above the lens (the post is a fixture box)
     const double lens = camera.camera_height;
-    const double boom_x0 = camera.area.centre.x(), boom_x1 = camera.stand.centre.x();
-    m.addBox({(boom_x0 + boom_x1) / 2, camera.area.centre.y(), lens + 0.06}, {boom_x1 - boom_x0, 0.03, 0.02},
-             {0.3, 0.3, 0.32});
-    m.addBox({camera.area.centre.x(), camera.area.centre.y(), lens + 0.035}, {0.11, 0.07, 0.07}, {0.08, 0.08, 0.08});
+    // the boom runs from the post to above the field of view's centre
+    const Eigen::Vector2d lens_at = camera.area.centre, post = camera.stand.centre;
+    const Eigen::Vector2d boom = (lens_at + post) / 2, along = post - lens_at;
+    m.addBox({boom.x(), boom.y(), lens + 0.06}, {along.norm(), 0.03, 0.02}, {0.3, 0.3, 0.32},
+             std::atan2(along.y(), along.x()));
+    m.addBox({lens_at.x(), lens_at.y(), lens + 0.035}, {0.11, 0.07, 0.07}, {0.08, 0.08, 0.08}, camera.area.yaw);
     for (const StationMarker& k : l.markers) k.draw(m);
   }
 
@@ -246,6 +254,9 @@ struct World::Impl {
     dMassSetBoxTotal(&m, kPlatformMass, pb.size.x(), pb.size.y(), pb.size.z());
     dBodySetMass(platform, &m);
     dBodySetPosition(platform, pb.centre.x(), pb.centre.y(), pb.centre.z());
+    dMatrix3 r;
+    dRFromAxisAndAngle(r, 0, 0, 1, pb.yaw);
+    dBodySetRotation(platform, r);
     dBodySetAutoDisableFlag(platform, 0);
     dGeomID pg = dCreateBox(space, pb.size.x(), pb.size.y(), pb.size.z());
     dGeomSetBody(pg, platform);
@@ -265,7 +276,7 @@ struct World::Impl {
       if (isPlatform(l, b)) {
         buildPlatform(l.station(StationType::Scale));
       } else {
-        staticBox(b.centre, b.size);
+        staticBox(b.centre, b.size, b.yaw);
       }
     }
     if (!platform) buildPlatform(l.station(StationType::Scale));  // a scale at table height
@@ -382,7 +393,8 @@ void World::spawn(const std::vector<SherdSpec>& sherds) {
     const double x = s->spec.pose.x(), y = s->spec.pose.y();
     double support = 0.0;  // the table, or a support surface (the scale platform) under it
     for (const FixtureBox& b : w.boxes) {
-      if (b.is_support && std::abs(x - b.centre.x()) < b.size.x() / 2 && std::abs(y - b.centre.y()) < b.size.y() / 2) {
+      const Eigen::Vector2d local = Eigen::Rotation2Dd(-b.yaw) * (Eigen::Vector2d(x, y) - b.centre.head<2>());
+      if (b.is_support && std::abs(local.x()) < b.size.x() / 2 && std::abs(local.y()) < b.size.y() / 2) {
         support = std::max(support, b.centre.z() + b.size.z() / 2);
       }
     }

@@ -29,7 +29,8 @@ std::vector<StationMarker> readMarkers(const rascal_workcell::Parameters& p, con
     StationMarker m;
     m.station = s.name;
     m.id = static_cast<int>(ids[i]);
-    m.centre = s.area.centre + Eigen::Vector2d(positions[i][0], positions[i][1]);
+    m.centre = s.area.toTable({positions[i][0], positions[i][1]});
+    m.yaw = s.area.yaw;
     markers.push_back(m);
   }
   return markers;
@@ -45,22 +46,27 @@ const Station* WorldLayout::find(const std::string& name) const {
   return nullptr;
 }
 
-// The workcell has no station yaw (stations are axis-aligned rectangles, as the arm controller
-// and perception model them), so a station's own bodies (mat, platform, walls, stand, chart,
-// bar) only move by (dx, dy); its markers carry the turn as well, which is what the calibration
-// measures.
+// The station moves as one rigid piece: its area, chart, bar, stand, place, fixture boxes and
+// markers turn by dyaw about the station's configured centre and shift by (dx, dy).
 void WorldLayout::offsetStation(const std::string& name, double dx, double dy, double dyaw) {
   const auto s = std::find_if(stations.begin(), stations.end(), [&](const Station& t) { return t.name == name; });
   if (s == stations.end()) throw std::invalid_argument("station_offsets." + name + ": no such station");
-  const Eigen::Vector2d shift(dx, dy), old_centre = s->area.centre;
-  for (TableRect* r : {&s->area, &s->colour_chart, &s->scale_bar, &s->stand}) r->centre += shift;
-  s->place_at += shift;
+  const Eigen::Vector2d old_centre = s->area.centre, new_centre = old_centre + Eigen::Vector2d(dx, dy);
+  const Eigen::Rotation2Dd turn(dyaw);
+  auto move = [&](const Eigen::Vector2d& p) { return Eigen::Vector2d(new_centre + turn * (p - old_centre)); };
+  for (TableRect* r : {&s->area, &s->colour_chart, &s->scale_bar, &s->stand}) {
+    r->centre = move(r->centre);
+    r->yaw += dyaw;
+  }
+  s->place_at = move(s->place_at);
   for (FixtureBox& b : boxes) {
-    if (b.station == name) b.centre.head<2>() += shift;
+    if (b.station != name) continue;
+    b.centre.head<2>() = move(b.centre.head<2>());
+    b.yaw += dyaw;
   }
   for (StationMarker& m : markers) {
     if (m.station != name) continue;
-    m.centre = s->area.centre + Eigen::Rotation2Dd(dyaw) * (m.centre - old_centre);
+    m.centre = move(m.centre);
     m.yaw += dyaw;
   }
 }

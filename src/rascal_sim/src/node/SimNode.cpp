@@ -81,6 +81,7 @@ void SimNode::sendStaticFrames() {
   const Station& station = sim_->world().layout().station(StationType::Scale);
   Eigen::Isometry3d scale = Eigen::Isometry3d::Identity();
   scale.translation() = Eigen::Vector3d(station.area.centre.x(), station.area.centre.y(), station.surface_z);
+  scale.linear() = Eigen::AngleAxisd(station.area.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   static_tf_.sendTransform({conversions::toTransform(sim_->archival().pose(), "base_link",
                                                      "archival_camera_optical_frame", ros::Time(0)),
                             conversions::toTransform(scale, "base_link", "scale_link", ros::Time(0))});

@@ -60,31 +60,54 @@ def top_down_reachable(x: float, y: float, z: float) -> bool:
 
 @dataclass(frozen=True)
 class Rect:
-    """Axis-aligned rectangle on the table: centre and size [along x, along y] in metres."""
+    """Rectangle on the table: centre and size [along its own x, along its own y] in metres,
+    turned by yaw [rad] about +z (its station's `yaw`; 0 = square to the arm's base)."""
 
     center: Tuple[float, float]
     size: Tuple[float, float]
+    yaw: float = 0.0
+
+    def to_local(self, p) -> Tuple[float, float]:
+        """p = (x, y) in base_link, in the rectangle's frame (origin at its centre, axes along
+        its sides)."""
+        dx, dy = p[0] - self.center[0], p[1] - self.center[1]
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return c * dx + s * dy, -s * dx + c * dy
+
+    def to_table(self, local) -> Tuple[float, float]:
+        """A point of the rectangle's frame in base_link."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return (
+            self.center[0] + c * local[0] - s * local[1],
+            self.center[1] + s * local[0] + c * local[1],
+        )
 
     def corners(self) -> List[Tuple[float, float]]:
-        cx, cy = self.center
         hx, hy = self.size[0] / 2, self.size[1] / 2
-        return [(cx - hx, cy - hy), (cx + hx, cy - hy), (cx + hx, cy + hy), (cx - hx, cy + hy)]
+        return [self.to_table(c) for c in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
 
     def overlaps(self, other: "Rect") -> bool:
-        return (
-            abs(self.center[0] - other.center[0]) * 2 < self.size[0] + other.size[0]
-            and abs(self.center[1] - other.center[1]) * 2 < self.size[1] + other.size[1]
-        )
+        """Whether the two share more than an edge (separating axes: each one's sides)."""
+        for r in (self, other):
+            c, s = math.cos(r.yaw), math.sin(r.yaw)
+            for ax in ((c, s), (-s, c)):
+                a = [ax[0] * x + ax[1] * y for x, y in self.corners()]
+                b = [ax[0] * x + ax[1] * y for x, y in other.corners()]
+                if max(a) <= min(b) + 1e-12 or max(b) <= min(a) + 1e-12:
+                    return False
+        return True
 
     def contains(self, other: "Rect") -> bool:
         return all(self.has(c) for c in other.corners())
 
     def has(self, p) -> bool:
         """Whether the point p = (x, y) lies on the rectangle."""
-        return (
-            abs(p[0] - self.center[0]) <= self.size[0] / 2 + 1e-9
-            and abs(p[1] - self.center[1]) <= self.size[1] / 2 + 1e-9
-        )
+        lx, ly = self.to_local(p)
+        return abs(lx) <= self.size[0] / 2 + 1e-9 and abs(ly) <= self.size[1] / 2 + 1e-9
+
+    def lawnmower(self, step: float) -> List[Tuple[float, float]]:
+        """Boustrophedon centres covering the rectangle (`lawnmower` in its own frame)."""
+        return [self.to_table(p) for p in lawnmower((0.0, 0.0), self.size, step)]
 
 
 @dataclass(frozen=True)
@@ -247,7 +270,7 @@ def _check_survey(source: str, cfg: dict, stations: Dict[str, Station]):
             survey_z,
         )
     pickup = next(s for s in stations.values() if s.type == "pickup")
-    for cx, cy in lawnmower(pickup.area.center, pickup.area.size, step):
+    for cx, cy in pickup.area.lawnmower(step):
         if not top_down_reachable(cx, cy, survey_z):
             _fail(
                 source,
@@ -271,8 +294,8 @@ def _only(source: str, stations, type_) -> str:
     return names[0]
 
 
-def _rect(section: dict) -> Rect:
-    return Rect(tuple(section["position"]), tuple(section["size"]))
+def _rect(section: dict, yaw: float = 0.0) -> Rect:
+    return Rect(tuple(section["position"]), tuple(section["size"]), float(yaw))
 
 
 def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
@@ -283,15 +306,16 @@ def _read_stations(source: str, sec: dict) -> Dict[str, Station]:
         type_ = st["type"]
         if type_ not in types:
             _fail(source, key + ".type", "expected one of %s" % ", ".join(types), type_)
-        area = _rect(st)
+        yaw = st.get("yaw", 0.0)  # everything on the station turns with it
+        area = _rect(st, yaw)
         surface_z = st["surface_z"]
         extra = {}
         if type_ == "archival_camera":
             place_at = tuple(st["place_at"])
             extra["camera_height"] = st["camera_height"]
-            extra["colour_chart"] = Fixture(_rect(st["colour_chart"]))
-            extra["scale_bar"] = Fixture(_rect(st["scale_bar"]))
-            extra["stand"] = Fixture(_rect(st["stand"]), st["stand"]["height"])
+            extra["colour_chart"] = Fixture(_rect(st["colour_chart"], yaw))
+            extra["scale_bar"] = Fixture(_rect(st["scale_bar"], yaw))
+            extra["stand"] = Fixture(_rect(st["stand"], yaw), st["stand"]["height"])
             extra["over_scale"] = bool(st.get("over_scale", False))
             for part in ("colour_chart", "scale_bar"):
                 if not area.contains(extra[part].area):
@@ -391,7 +415,11 @@ def _scale_under_camera(source: str, sec: dict, stations: Dict[str, Station], ca
             % (key, _fmt_rect(cam.area)),
             _fmt_rect(scale.area),
         )
-    housing = Rect(scale.area.center, tuple(v + 2 * SCALE_HOUSING_MARGIN for v in scale.area.size))
+    housing = Rect(
+        scale.area.center,
+        tuple(v + 2 * SCALE_HOUSING_MARGIN for v in scale.area.size),
+        scale.area.yaw,
+    )
     for part in ("colour_chart", "scale_bar"):
         fixture = getattr(cam, part).area
         if fixture.overlaps(housing):
@@ -471,10 +499,10 @@ def _check_markers(source: str, sec: dict, stations: Dict[str, Station], cam: St
                     ids,
                 )
             seen[int(i)] = name
-        centre = stations[name].area.center
+        area = stations[name].area
         for offset in positions:
-            xy = (centre[0] + offset[0], centre[1] + offset[1])
-            square = Rect(xy, (MARKER_SIZE * 4 / 3, MARKER_SIZE * 4 / 3))  # with the margin
+            xy = area.to_table(offset)  # offsets are in the station's frame
+            square = Rect(xy, (MARKER_SIZE * 4 / 3,) * 2, area.yaw)  # with the margin
             for other in list(stations.values()) + [
                 Station("stand", "stand", cam.stand.area, 0.0, xy)
             ]:
@@ -540,4 +568,5 @@ def _max_radius(z: float) -> float:
 
 
 def _fmt_rect(r: Rect) -> str:
-    return "centre [%.3f, %.3f] size [%.3f, %.3f]" % (r.center + r.size)
+    turned = " yaw %.3f" % r.yaw if r.yaw else ""
+    return "centre [%.3f, %.3f] size [%.3f, %.3f]%s" % (r.center + r.size + (turned,))

@@ -41,7 +41,7 @@ from typing import Callable, Dict, List, Tuple
 
 from rascal_tasks.config import Config
 from rascal_tasks.joint_motion import move_time
-from rascal_tasks.survey import gripper_for_camera_over, lawnmower
+from rascal_tasks.survey import gripper_for_camera_over
 
 # rascal_sim ScaleSensor (timing.md): first-order settling, readings every 0.1 s
 SCALE_TIME_CONSTANT = 0.3  # [s]
@@ -168,7 +168,7 @@ def camera_over_steps(cfg: Config, spots, what: str) -> List[Step]:
 
 def survey_steps(cfg: Config) -> List[Step]:
     st = cfg.stations["pickup"]
-    spots = lawnmower(st.area.center, st.area.size, cfg["survey"]["step"])
+    spots = st.area.lawnmower(cfg["survey"]["step"])
     return camera_over_steps(cfg, spots, "survey")
 
 
@@ -241,10 +241,10 @@ def bound_of(cfg: Config, ik: Callable, sherds: int = 10) -> Dict[str, float]:
     park), as the measured seconds per sherd count them; `cycle`: the sherd's own plus its
     share of one survey alone (the batch's start and end left out)."""
     st = cfg.stations["pickup"]
-    (cx, cy), (sx, sy) = st.area.center, st.area.size
+    sx, sy = st.area.size
     nx, ny = PICKUP_GRID
     spots = [
-        (cx - sx / 2 + (i + 0.5) * sx / nx, cy - sy / 2 + (j + 0.5) * sy / ny)
+        st.area.to_table((-sx / 2 + (i + 0.5) * sx / nx, -sy / 2 + (j + 0.5) * sy / ny))
         for i in range(nx)
         for j in range(ny)
     ]

@@ -11,7 +11,7 @@ from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
 from rascal_tasks.selection import SAME_SHERD, among_others, covered, itself, same_size
-from rascal_tasks.survey import lawnmower, reachable_look_yaws, survey_at
+from rascal_tasks.survey import reachable_look_yaws, survey_at
 from rascal_tasks.wrist import route_yaw, same_grasp_yaws
 
 
@@ -219,6 +219,6 @@ def look_from(b, o: Observation) -> Tuple[float, float, Optional[float]]:
     if reachable:
         return o.x, o.y, reachable[0]
     area = b.pickup.area
-    views = lawnmower(area.center, area.size, b.config["survey"]["step"])
+    views = area.lawnmower(b.config["survey"]["step"])
     x, y = min(views, key=lambda v: o.distance_to(*v))
     return x, y, None

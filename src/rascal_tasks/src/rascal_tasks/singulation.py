@@ -54,7 +54,8 @@ def _roomiest(it, directions, travel, half, others, area) -> Optional[Tuple[floa
     best, best_room = None, -math.inf
     for d in directions:
         end = (it.x + travel * d[0], it.y + travel * d[1])
-        if any(abs(end[i] - area.center[i]) > area.size[i] / 2 - half for i in (0, 1)):
+        local = area.to_local(end)
+        if any(abs(local[i]) > area.size[i] / 2 - half for i in (0, 1)):
             continue  # would leave the mat
         room = min(
             (math.hypot(end[0] - p.x, end[1] - p.y) - p.length / 2 for p in others if p is not it),

@@ -338,20 +338,18 @@ def free_spot(area, seen, step=0.01, inset=0.035):
     outline because what is set down there can fall apart or roll over it (heap_20 seed 59: two
     put back 35 mm from the edge, where the heap left the most room, rolled to it and one was
     pushed off by a later grasp beside it); an empty mat's freest spot is its middle."""
-    (cx, cy), (sx, sy) = area.center, area.size
+    sx, sy = area.size
     nx, ny = max(1, int((sx - 2 * inset) / step)), max(1, int((sy - 2 * inset) / step))
-    grid = [
-        (
-            cx - sx / 2 + inset + i * (sx - 2 * inset) / nx,
-            cy - sy / 2 + inset + j * (sy - 2 * inset) / ny,
-        )
+    grid = [  # in the mat's own frame
+        (-sx / 2 + inset + i * (sx - 2 * inset) / nx, -sy / 2 + inset + j * (sy - 2 * inset) / ny)
         for i in range(nx + 1)
         for j in range(ny + 1)
     ]
-    grid.sort(key=lambda p: math.hypot(p[0] - cx, p[1] - cy))  # of equal room, the middlemost
-    best, room = (cx, cy), -1.0
-    for x, y in grid:
-        edge = min(sx / 2 - abs(x - cx), sy / 2 - abs(y - cy))
+    grid.sort(key=lambda p: math.hypot(*p))  # of equal room, the middlemost
+    best, room = area.center, -1.0
+    for lx, ly in grid:
+        x, y = area.to_table((lx, ly))
+        edge = min(sx / 2 - abs(lx), sy / 2 - abs(ly))
         r = min([o.distance_to(x, y) - o.length / 2 for o in seen] + [edge])
         if r > room + 1e-9:
             best, room = (x, y), r

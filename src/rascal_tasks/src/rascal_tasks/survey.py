@@ -91,8 +91,8 @@ def survey_at(b, station, x, y, yaw=None) -> List[Observation]:
 def on_the_mat(area, lo) -> bool:
     """Whether leftover `lo` reaches onto the pickup area (config.Rect): its centre within half
     its length of it (one at the mat's edge is the bag's; the table beyond is not)."""
-    (cx, cy), (sx, sy) = area.center, area.size
-    return abs(lo.x - cx) <= sx / 2 + lo.length / 2 and abs(lo.y - cy) <= sy / 2 + lo.length / 2
+    (lx, ly), (sx, sy) = area.to_local((lo.x, lo.y)), area.size
+    return abs(lx) <= sx / 2 + lo.length / 2 and abs(ly) <= sy / 2 + lo.length / 2
 
 
 def describe_leftover(lo) -> str:
@@ -176,8 +176,8 @@ def account_for_slips(b, found: List[Observation]):
 def near_the_edge(area, o: Observation) -> bool:
     """Whether `o` lies within its own length of the pickup area's edge (config.Rect): a shove
     of its own size could put it off the mat."""
-    (cx, cy), (sx, sy) = area.center, area.size
-    return min(sx / 2 - abs(o.x - cx), sy / 2 - abs(o.y - cy)) <= o.length
+    (lx, ly), (sx, sy) = area.to_local((o.x, o.y)), area.size
+    return min(sx / 2 - abs(lx), sy / 2 - abs(ly)) <= o.length
 
 
 def taken_off_the_mat(b, grasped: Observation, surveyed: Optional[Observation] = None):
@@ -366,7 +366,7 @@ def survey_pickup_area(b) -> List[Observation]:
             ],
         )
 
-    for x, y in lawnmower(b.pickup.area.center, b.pickup.area.size, b.config["survey"]["step"]):
+    for x, y in b.pickup.area.lawnmower(b.config["survey"]["step"]):
         look(x, y)
     look_at_cut_sherds(b, look, found, parts)
     # a sherd seen whole in a later view is not a leftover of an earlier one

@@ -70,14 +70,8 @@ def jogged(place: Place, command: str, area) -> Place:
     new = Place(place.x + dx, place.y + dy, place.yaw)
     if not area.has((new.x, new.y)):
         raise TeachError(
-            "%s: would leave the station (x %.3f..%.3f, y %.3f..%.3f m); the place must lie on it"
-            % (
-                command.strip(),
-                area.center[0] - area.size[0] / 2,
-                area.center[0] + area.size[0] / 2,
-                area.center[1] - area.size[1] / 2,
-                area.center[1] + area.size[1] / 2,
-            )
+            "%s: would leave the station (corners %s m); the place must lie on it"
+            % (command.strip(), ", ".join("(%.3f, %.3f)" % c for c in area.corners()))
         )
     return new
 

@@ -21,14 +21,21 @@ enum class StationType { Pickup, Scale, ArchivalCamera, Discard, Bin, Other };
 std::string toString(StationType type);
 StationType stationTypeFromString(const std::string& name);  ///< Other for any other name
 
-/// A rectangle on the table: centre and size [along x, along y] in base_link, metres.
+/// A rectangle on the table: centre and size [along its own x, along its own y] in base_link,
+/// metres, turned by yaw [rad] about +z (its station's yaw; 0 = square to the arm's base).
 struct TableRect {
   Eigen::Vector2d centre{0.0, 0.0};
   Eigen::Vector2d size{0.0, 0.0};
+  double yaw = 0.0;
   bool contains(const Eigen::Vector2d& p) const;
+  /// p (base_link) in the rectangle's own frame: origin at its centre, axes along its sides.
+  Eigen::Vector2d toLocal(const Eigen::Vector2d& p) const;
+  /// A point of the rectangle's own frame in base_link.
+  Eigen::Vector2d toTable(const Eigen::Vector2d& local) const;
 };
 
-/// An axis-aligned box in base_link, metres: what the arm must not touch.
+/// A box standing on the table, in base_link, metres, turned by yaw [rad] about +z (its
+/// station's yaw): what the arm must not touch.
 struct FixtureBox {
   std::string name;        ///< e.g. "scale housing", "discard box wall +y", "camera stand"
   std::string station;     ///< the station it belongs to
@@ -36,6 +43,7 @@ struct FixtureBox {
   Eigen::Vector3d size{0.0, 0.0, 0.0};
   bool is_support = false; ///< a surface sherds are put on (the scale platform): the arm may
                            ///< touch its top while placing, a held sherd may rest on it
+  double yaw = 0.0;
 };
 
 struct Station {

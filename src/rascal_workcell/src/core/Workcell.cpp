@@ -1,5 +1,6 @@
 #include "rascal_workcell/Workcell.hpp"
 
+#include <Eigen/Geometry>
 #include <stdexcept>
 
 namespace rascal_workcell {
@@ -25,15 +26,24 @@ StationType stationTypeFromString(const std::string& name) {
 }
 
 bool TableRect::contains(const Eigen::Vector2d& p) const {
-  return ((p - centre).cwiseAbs() - size / 2.0).maxCoeff() <= 1e-9;
+  return (toLocal(p).cwiseAbs() - size / 2.0).maxCoeff() <= 1e-9;
+}
+
+Eigen::Vector2d TableRect::toLocal(const Eigen::Vector2d& p) const {
+  return Eigen::Rotation2Dd(-yaw) * (p - centre);
+}
+
+Eigen::Vector2d TableRect::toTable(const Eigen::Vector2d& local) const {
+  return centre + Eigen::Rotation2Dd(yaw) * local;
 }
 
 Workcell Workcell::fromParameters(const Parameters& p) {
   Workcell w;
   for (const std::string& name : p.names("stations")) {
     const std::string key = "stations." + name + ".";
+    const double yaw = p.number(key + "yaw");  // everything on a station turns with it
     auto rect = [&](const std::string& prefix) {
-      return TableRect{p.xy(key + prefix + "position"), p.xy(key + prefix + "size")};
+      return TableRect{p.xy(key + prefix + "position"), p.xy(key + prefix + "size"), yaw};
     };
     Station s;
     s.name = name;
@@ -88,21 +98,25 @@ const Station* Workcell::find(const std::string& name) const {
 std::vector<FixtureBox> Workcell::collisionBoxes() const {
   std::vector<FixtureBox> boxes;
   for (const Station& s : stations_) {
-    const Eigen::Vector2d& c = s.area.centre;
-    const Eigen::Vector2d& d = s.area.size;
+    const TableRect& a = s.area;
+    const Eigen::Vector2d& d = a.size;
+    // a box at `local` in the station's own frame, turned with it
+    auto box = [&](const std::string& name, const Eigen::Vector2d& local, double z, const Eigen::Vector3d& size,
+                   bool support) {
+      const Eigen::Vector2d c = a.toTable(local);
+      return FixtureBox{name, s.name, {c.x(), c.y(), z}, size, support, a.yaw};
+    };
     switch (s.type) {
       case StationType::Scale: {
         // The housing under the platform reaches beyond it; the platform on top is a support.
         const double housing = s.surface_z - kScalePlatformThickness;
         if (housing > 0.0) {
-          boxes.push_back({"scale housing", s.name, {c.x(), c.y(), housing / 2.0},
-                           {d.x() + 2 * kScaleHousingMargin, d.y() + 2 * kScaleHousingMargin, housing},
-                           false});
+          boxes.push_back(box("scale housing", {0, 0}, housing / 2.0,
+                              {d.x() + 2 * kScaleHousingMargin, d.y() + 2 * kScaleHousingMargin, housing}, false));
         }
         const double thickness = std::min(kScalePlatformThickness, s.surface_z);
         if (thickness > 0.0) {
-          boxes.push_back({"scale platform", s.name, {c.x(), c.y(), s.surface_z - thickness / 2.0},
-                           {d.x(), d.y(), thickness}, true});
+          boxes.push_back(box("scale platform", {0, 0}, s.surface_z - thickness / 2.0, {d.x(), d.y(), thickness}, true));
         }
         break;
       }
@@ -111,16 +125,16 @@ std::vector<FixtureBox> Workcell::collisionBoxes() const {
         // Four walls centred on the box outline; the long ones overlap the corners.
         const double w = kDiscardWallThickness, h = s.wall_height;
         if (h <= 0.0) break;
-        const std::string box = s.type == StationType::Bin ? "bin " + s.name : "discard box";
-        boxes.push_back({box + " wall +y", s.name, {c.x(), c.y() + d.y() / 2, h / 2}, {d.x() + w, w, h}, false});
-        boxes.push_back({box + " wall -y", s.name, {c.x(), c.y() - d.y() / 2, h / 2}, {d.x() + w, w, h}, false});
-        boxes.push_back({box + " wall +x", s.name, {c.x() + d.x() / 2, c.y(), h / 2}, {w, d.y() + w, h}, false});
-        boxes.push_back({box + " wall -x", s.name, {c.x() - d.x() / 2, c.y(), h / 2}, {w, d.y() + w, h}, false});
+        const std::string name = s.type == StationType::Bin ? "bin " + s.name : "discard box";
+        boxes.push_back(box(name + " wall +y", {0, d.y() / 2}, h / 2, {d.x() + w, w, h}, false));
+        boxes.push_back(box(name + " wall -y", {0, -d.y() / 2}, h / 2, {d.x() + w, w, h}, false));
+        boxes.push_back(box(name + " wall +x", {d.x() / 2, 0}, h / 2, {w, d.y() + w, h}, false));
+        boxes.push_back(box(name + " wall -x", {-d.x() / 2, 0}, h / 2, {w, d.y() + w, h}, false));
         break;
       }
       case StationType::ArchivalCamera:
         boxes.push_back({"camera stand", s.name, {s.stand.centre.x(), s.stand.centre.y(), s.stand_height / 2},
-                         {s.stand.size.x(), s.stand.size.y(), s.stand_height}, false});
+                         {s.stand.size.x(), s.stand.size.y(), s.stand_height}, false, s.stand.yaw});
         break;
       case StationType::Pickup:
       case StationType::Other:
