@@ -117,12 +117,12 @@ def _pose(shift=(0.0, 0.0), turn=0.0, mismatch=0.0):
 
 
 def test_refusals_name_the_station_and_the_fix():
-    mc.check_pose(_pose((0.03, 0.0), math.radians(1.9)))  # within what is corrected
+    mc.check_pose(_pose((0.03, 0.0), math.radians(5.0)))  # within what is corrected
     with pytest.raises(
         mc.CalibrationError,
-        match=r"stations\.discard: turned 5\.0° clockwise.*turn it back anticlockwise",
+        match=r"stations\.discard: turned 12\.0° clockwise.*turn it back anticlockwise",
     ):
-        mc.check_pose(_pose(turn=math.radians(-5.0)))
+        mc.check_pose(_pose(turn=math.radians(-12.0)))
     with pytest.raises(mc.CalibrationError, match=r"stations\.discard: the markers put it 60 mm"):
         mc.check_pose(_pose((0.06, 0.0)))
     with pytest.raises(mc.CalibrationError, match=r"marker_positions again"):
@@ -221,3 +221,31 @@ def test_the_printed_sheet_holds_every_configured_marker_at_40_mm():
     assert sorted(found) == list(range(8))
     side = np.linalg.norm(found[0][1] - found[0][0])  # px between the outer black edges
     assert side / 300 * 0.0254 == pytest.approx(mc.MARKER_SIZE, abs=0.0002)
+
+
+def test_a_turned_station_is_written_turned_with_everything_on_it():
+    """move_stations turns the camera's places about its old centre and carries them to the
+    measured one; its yaw is written as its own key (what `rascal calibrate` does at 5°)."""
+    with open(SHIPPED, encoding="utf-8") as f:
+        text = f.read()
+    before = yaml.safe_load(text)["stations"]["camera"]
+    old, new, turn = tuple(before["position"]), (0.33, -0.29), math.radians(5.0)
+    out = site_file.move_stations(text, {"camera": (old, new, turn)})
+    out = site_file.set_station_value(out, "camera", "yaw", turn)
+    after = yaml.safe_load(out)["stations"]["camera"]
+    assert after["position"] == pytest.approx(list(new), abs=1e-4)
+    assert after["yaw"] == pytest.approx(turn, abs=1e-4)
+    for key in ("place_at",):
+        p = np.subtract(before[key], old) @ _turn(turn).T + new
+        assert after[key] == pytest.approx(list(p), abs=1e-4)
+    for part in ("colour_chart", "scale_bar", "stand"):
+        p = np.subtract(before[part]["position"], old) @ _turn(turn).T + new
+        assert after[part]["position"] == pytest.approx(list(p), abs=1e-4), part
+        assert after[part]["size"] == before[part]["size"]
+    cfg = config_from_dict(yaml.safe_load(out))  # the written layout loads, turned
+    cam = cfg.stations["camera"]
+    assert cam.area.yaw == pytest.approx(turn, abs=1e-4)
+    assert cam.colour_chart.area.yaw == pytest.approx(turn, abs=1e-4)
+    spec = next(s for s in mc.stations_with_markers(cfg) if s.station == "camera")
+    x, y = spec.markers[0].offset
+    assert spec.marker_position(0) == pytest.approx(tuple(cam.area.to_table((x, y))))

@@ -61,7 +61,7 @@ class Calibration:
             for p in problems:
                 print("error: %s" % p, file=sys.stderr)
             return exit_codes.fail("nothing written", exit_codes.INCOMPLETE)
-        moved = {p.station: p.shift for p in poses if p.shift_norm > mc.POSITION_TOLERANCE}
+        moved = {p.station: p for p in poses if not p.confirmed()}
         if not moved:
             print(
                 "layout confirmed: every station within %.0f mm and %.1f° of %s; nothing written"
@@ -173,18 +173,33 @@ class Calibration:
             )
 
     def write(self, poses, moved) -> int:
+        """The site file with each station of `moved` (name -> StationPose) moved and turned to
+        where it was measured, written to self.output once it loads and holds them."""
         with open(self.config_path, encoding="utf-8") as f:
             text = f.read()
-        corrected = site_file.shift_stations(text, moved)
+        # a turn within the tolerance is the measurement's noise: the station keeps its yaw
+        turns = {
+            n: p.turned if abs(p.turned) > mc.TURN_TOLERANCE else 0.0 for n, p in moved.items()
+        }
+        corrected = site_file.move_stations(
+            text, {n: (p.configured, p.measured, turns[n]) for n, p in moved.items()}
+        )
+        for n, p in moved.items():
+            if turns[n]:
+                corrected = site_file.set_station_value(corrected, n, "yaw", round(p.turn, 4))
         tmp = self.output + ".tmp"
         with open(tmp, "w", encoding="utf-8") as f:
             f.write(corrected)
         try:  # the written layout must load like any other and hold what was measured
             written = load_config(tmp)
             for p in poses:
-                got = written["stations"][p.station]["position"]
-                if p.station in moved and math.dist(got, p.measured) > 1e-4:
+                got = written["stations"][p.station]
+                if p.station not in moved:
+                    continue
+                if math.dist(got["position"], p.measured) > 1e-4:
                     raise ConfigError("stations.%s.position: not rewritten" % p.station)
+                if turns[p.station] and abs(got.get("yaw", 0.0) - p.turn) > 1e-3:
+                    raise ConfigError("stations.%s.yaw: not rewritten" % p.station)
         except ConfigError as e:
             os.unlink(tmp)
             return exit_codes.fail(

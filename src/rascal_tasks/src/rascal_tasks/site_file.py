@@ -7,6 +7,7 @@ style (`scale: {type: scale, ...}`) is left alone, and the caller's check of the
 then finds the value unchanged.
 """
 
+import math
 import re
 from typing import Dict, Iterator, List, Sequence, Tuple
 
@@ -45,23 +46,37 @@ def _split_comment(rest: str) -> Tuple[str, str]:
     return value, sep + comment
 
 
-def _numbers(values: Sequence[float]) -> str:
+def _numbers(values) -> str:
+    """`[a, b]` of a sequence, or one number."""
+    if isinstance(values, (int, float)):
+        return "%.4f" % values
     return "[%s]" % ", ".join("%.4f" % v for v in values)
 
 
 def shift_stations(text: str, shifts: Dict[str, Tuple[float, float]]) -> str:
     """Every place of each shifted station (MOVING) moved by its (dx, dy) [m]."""
+    return move_stations(text, {n: ((0.0, 0.0), d, 0.0) for n, d in shifts.items()})
+
+
+def move_stations(text: str, moves: Dict[str, Tuple[Tuple[float, float], Tuple, float]]) -> str:
+    """Every place of each moved station (MOVING) turned by its dyaw [rad] about `old`, its
+    centre, and carried to `new` (moves: station -> (old, new, dyaw)); a taught place's yaw
+    turns with it."""
     out = []
     for body, end, keys, _ in _walk(text):
-        if len(keys) >= 3 and keys[0] == "stations" and keys[1] in shifts:
+        if len(keys) >= 3 and keys[0] == "stations" and keys[1] in moves:
             if tuple(keys[2:]) in MOVING:
                 head, rest = body.split(":", 1)
                 value, comment = _split_comment(rest)
                 m = _LIST.search(value)
                 if m:
+                    (ox, oy), (nx, ny), dyaw = moves[keys[1]]
                     items = [float(v) for v in m.group("items").split(",")]
-                    items[0] += shifts[keys[1]][0]
-                    items[1] += shifts[keys[1]][1]
+                    c, s = math.cos(dyaw), math.sin(dyaw)
+                    x, y = items[0] - ox, items[1] - oy
+                    items[0], items[1] = nx + c * x - s * y, ny + s * x + c * y
+                    if keys[2:] == ["taught_place"] and len(items) > 2:
+                        items[2] = math.remainder(items[2] + dyaw, 2 * math.pi)
                     value = value[: m.start()] + _numbers(items) + value[m.end() :]
                     body = "%s:%s%s" % (head, value, comment)
         out.append(body + end)
