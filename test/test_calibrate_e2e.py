@@ -10,7 +10,7 @@ import os
 
 import pytest
 import yaml
-from rig_helpers import SMALL, joint_positions
+from rig_helpers import SMALL, joint_positions, rows, run_batch
 
 from rascal_tasks import exit_codes
 from rascal_tasks.config import config_from_dict
@@ -91,9 +91,10 @@ def test_moved_stations_are_found_and_a_corrected_layout_written(rig_factory, tm
     assert all(abs(a - b) < 0.05 for a, b in zip(joint_positions(rig), SLEEP, strict=True))
 
 
-def test_turned_stations_are_written_with_their_yaw(rig_factory, tmp_path):
+def test_turned_stations_are_written_with_their_yaw(rig_factory, db, tmp_path):
     """The issue's 5°: the discard box turned 5° and the mat -3° are measured and written turned
-    (their yaw, the box's walls with them); the scale only shifted keeps no yaw."""
+    (their yaw, the box's walls with them); the scale only shifted keeps no yaw. A batch on the
+    written layout, on the same turned table, records every sherd."""
     offsets = {
         "discard": (-0.01, 0.02, math.radians(5.0)),
         "pickup": (0.01, -0.01, math.radians(-3.0)),
@@ -116,3 +117,14 @@ def test_turned_stations_are_written_with_their_yaw(rig_factory, tmp_path):
     assert config_from_dict(written).stations["discard"].area.yaw == pytest.approx(
         written["stations"]["discard"]["yaw"]
     )
+    rig.stop()
+    layout = tmp_path / "calibrated_stations.yaml"
+    layout.write_text(yaml.safe_dump({"stations": written["stations"]}))
+    rig = rig_factory(
+        scenario=scenario_with(tmp_path, offsets), archive=tmp_path / "archive2", over=[str(layout)]
+    )
+    code, out = run_batch(rig, db, "TURNED-3")
+    assert code == exit_codes.COMPLETE, out[-3000:] + rig.tail()
+    recorded = rows(db, "TURNED-3")
+    assert [r["seq"] for r in recorded] == [1, 2, 3], out[-2000:]
+    assert all(r["status"] == "done" for r in recorded), recorded
