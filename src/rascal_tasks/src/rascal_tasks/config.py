@@ -88,11 +88,12 @@ class Rect:
 
     def overlaps(self, other: "Rect") -> bool:
         """Whether the two share more than an edge (separating axes: each one's sides)."""
+        mine, theirs = self.corners(), other.corners()
         for r in (self, other):
             c, s = math.cos(r.yaw), math.sin(r.yaw)
             for ax in ((c, s), (-s, c)):
-                a = [ax[0] * x + ax[1] * y for x, y in self.corners()]
-                b = [ax[0] * x + ax[1] * y for x, y in other.corners()]
+                a = [ax[0] * x + ax[1] * y for x, y in mine]
+                b = [ax[0] * x + ax[1] * y for x, y in theirs]
                 if max(a) <= min(b) + 1e-12 or max(b) <= min(a) + 1e-12:
                     return False
         return True
