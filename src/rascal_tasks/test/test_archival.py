@@ -312,6 +312,27 @@ def test_a_sherd_on_the_scale_pan_under_the_camera_is_measured_on_the_pan(seed):
     assert any("platform the sherd lies on could not be placed" in f for f in r3.flags)
 
 
+def test_a_turned_pan_is_looked_at_turned():
+    """The scale's platform under the camera turned by its station's yaw: the outline the
+    sherd is looked for in turns with it about its centre (a pan 120 x 100 mm turned a quarter
+    turn covers what one 100 x 120 mm does; turned 20°, its corners are the turned ones)."""
+    centre = (0.23, -0.28)
+    quarter = Support(centre, (0.12, 0.10), 0.025, np.pi / 2).outline(0.01)
+    across = Support(centre, (0.10, 0.12), 0.025).outline(0.01)
+    assert sorted(np.round(quarter, 9).tolist()) == sorted(np.round(across, 9).tolist())
+    a = np.radians(20.0)
+    first = Support(centre, (0.12, 0.10), 0.025, a).outline(0.01)[0]
+    hx, hy = 0.05, 0.04
+    expected = (
+        centre[0] - hx * np.cos(a) + hy * np.sin(a),
+        centre[1] - hx * np.sin(a) - hy * np.cos(a),
+    )
+    assert first == pytest.approx(expected, abs=1e-12)
+    assert Support(centre, (0.12, 0.10), 0.025, a).outline(0.01) != Support(
+        centre, (0.12, 0.10), 0.025
+    ).outline(0.01)
+
+
 @pytest.mark.parametrize("seed", [3, 8])
 def test_a_bar_fit_by_features_that_the_chart_does_not_bear_out_yields_to_its_outline(
     seed, monkeypatch

@@ -27,6 +27,7 @@ import yaml
 from rascal_workcell import schema, urdf_model
 from rascal_workcell.fixtures import SCALE_HOUSING_MARGIN
 
+from rascal_tasks.planar import local_of, placed, turned
 from rascal_tasks.sorting import Rule, RuleError, parse_rule
 from rascal_tasks.stations import STATION_PLUGINS
 from rascal_tasks.survey import lawnmower
@@ -70,17 +71,11 @@ class Rect:
     def to_local(self, p) -> Tuple[float, float]:
         """p = (x, y) in base_link, in the rectangle's frame (origin at its centre, axes along
         its sides)."""
-        dx, dy = p[0] - self.center[0], p[1] - self.center[1]
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        return c * dx + s * dy, -s * dx + c * dy
+        return local_of(self.center, self.yaw, p)
 
     def to_table(self, local) -> Tuple[float, float]:
         """A point of the rectangle's frame in base_link."""
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        return (
-            self.center[0] + c * local[0] - s * local[1],
-            self.center[1] + s * local[0] + c * local[1],
-        )
+        return placed(self.center, self.yaw, local)
 
     def corners(self) -> List[Tuple[float, float]]:
         hx, hy = self.size[0] / 2, self.size[1] / 2
@@ -90,8 +85,7 @@ class Rect:
         """Whether the two share more than an edge (separating axes: each one's sides)."""
         mine, theirs = self.corners(), other.corners()
         for r in (self, other):
-            c, s = math.cos(r.yaw), math.sin(r.yaw)
-            for ax in ((c, s), (-s, c)):
+            for ax in (turned((1.0, 0.0), r.yaw), turned((0.0, 1.0), r.yaw)):
                 a = [ax[0] * x + ax[1] * y for x, y in mine]
                 b = [ax[0] * x + ax[1] * y for x, y in theirs]
                 if max(a) <= min(b) + 1e-12 or max(b) <= min(a) + 1e-12:

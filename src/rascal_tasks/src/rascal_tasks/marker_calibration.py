@@ -21,6 +21,8 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from rascal_tasks.planar import placed
+
 # What is printed and stuck on (docs/markers: print at 100 %, 40 mm between the outer black
 # edges; a white margin of one cell around it).
 MARKER_SIZE = 0.040  # [m]
@@ -55,8 +57,7 @@ class StationMarkers:
 
     def marker_position(self, i: int) -> Tuple[float, float]:
         """Where the configuration puts marker i in base_link (the camera looks there)."""
-        (x, y), c, s = self.markers[i].offset, math.cos(self.yaw), math.sin(self.yaw)
-        return self.centre[0] + c * x - s * y, self.centre[1] + s * x + c * y
+        return placed(self.centre, self.yaw, self.markers[i].offset)
 
 
 @dataclass(frozen=True)

@@ -152,6 +152,7 @@ class Recorder:
                 tuple(lies_on.area.center),
                 tuple(lies_on.area.size),
                 lies_on.surface_z - station.surface_z,
+                lies_on.area.yaw,
             ),
         )
 

@@ -11,6 +11,8 @@ import math
 import re
 from typing import Dict, Iterator, List, Sequence, Tuple
 
+from rascal_tasks.planar import local_of, placed
+
 # Keys under a station whose first two numbers are a place on the table that moves with it.
 MOVING = {
     ("position",),
@@ -70,11 +72,9 @@ def move_stations(text: str, moves: Dict[str, Tuple[Tuple[float, float], Tuple, 
                 value, comment = _split_comment(rest)
                 m = _LIST.search(value)
                 if m:
-                    (ox, oy), (nx, ny), dyaw = moves[keys[1]]
+                    old, new, dyaw = moves[keys[1]]
                     items = [float(v) for v in m.group("items").split(",")]
-                    c, s = math.cos(dyaw), math.sin(dyaw)
-                    x, y = items[0] - ox, items[1] - oy
-                    items[0], items[1] = nx + c * x - s * y, ny + s * x + c * y
+                    items[:2] = placed(new, dyaw, local_of(old, 0.0, items[:2]))
                     if keys[2:] == ["taught_place"] and len(items) > 2:
                         items[2] = math.remainder(items[2] + dyaw, 2 * math.pi)
                     value = value[: m.start()] + _numbers(items) + value[m.end() :]

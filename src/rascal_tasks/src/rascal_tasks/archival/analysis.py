@@ -17,6 +17,7 @@ from rascal_tasks.archival import chart as ch
 from rascal_tasks.archival import colour as col
 from rascal_tasks.archival import size as sz
 from rascal_tasks.archival.munsell import soil_chart
+from rascal_tasks.planar import placed
 
 MAX_CHART_DE00 = 3.0  # mean CIEDE2000 of the chart above this: the colour is flagged
 MAX_CHIP_DE00 = 6.0  # the nearest soil-chart chip farther than this: flagged (glaze, paint)
@@ -75,17 +76,18 @@ class Placement:
 @dataclass
 class Support:
     """What the sherd lies on when it is not the table around the targets: the scale's
-    platform under the camera (`over_scale`), its outline on the table (m, base_link) and its
-    top above the chart's and bar's plane."""
+    platform under the camera (`over_scale`), its outline on the table (m, base_link; turned
+    by its station's yaw) and its top above the chart's and bar's plane."""
 
     center: Tuple[float, float]
     size: Tuple[float, float]
     height_m: float
+    yaw: float = 0.0
 
     def outline(self, inset: float) -> List[Tuple[float, float]]:
         hx, hy = self.size[0] / 2 - inset, self.size[1] / 2 - inset
-        cx, cy = self.center
-        return [(cx - hx, cy - hy), (cx + hx, cy - hy), (cx + hx, cy + hy), (cx - hx, cy + hy)]
+        corners = ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))
+        return [placed(self.center, self.yaw, c) for c in corners]
 
 
 @dataclass
