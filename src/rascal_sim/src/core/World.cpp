@@ -393,8 +393,7 @@ void World::spawn(const std::vector<SherdSpec>& sherds) {
     const double x = s->spec.pose.x(), y = s->spec.pose.y();
     double support = 0.0;  // the table, or a support surface (the scale platform) under it
     for (const FixtureBox& b : w.boxes) {
-      const Eigen::Vector2d local = Eigen::Rotation2Dd(-b.yaw) * (Eigen::Vector2d(x, y) - b.centre.head<2>());
-      if (b.is_support && std::abs(local.x()) < b.size.x() / 2 && std::abs(local.y()) < b.size.y() / 2) {
+      if (b.is_support && b.footprint().contains({x, y})) {
         support = std::max(support, b.centre.z() + b.size.z() / 2);
       }
     }

@@ -44,6 +44,8 @@ struct FixtureBox {
   bool is_support = false; ///< a surface sherds are put on (the scale platform): the arm may
                            ///< touch its top while placing, a held sherd may rest on it
   double yaw = 0.0;
+  /// What it covers of the table (its outline seen from above).
+  TableRect footprint() const { return {centre.head<2>(), size.head<2>(), yaw}; }
 };
 
 struct Station {
