@@ -99,6 +99,8 @@ class Batch:
         self.taken_since_survey: List[tuple] = []
         # sherds that slipped while lifted, or lay near the mat's edge, and were not seen again
         self.not_seen_again: List[NotSeenAgain] = []
+        # (id, id) of the sherds told apart by colour and logged so (each pair said once)
+        self.said_another: set = set()
         # what the last survey saw on the mat but perception did not offer (rig.Leftover)
         self.leftovers: List = []
         self.empty_surveys = 0

@@ -224,9 +224,8 @@ def _surely_another(b, c, o: Observation) -> bool:
     once a batch: look_for asks each pair more than once)."""
     if not surely_another(c, o):
         return False
-    said = b.__dict__.setdefault("_said_another", set())
-    if (id(c), id(o)) not in said:
-        said.add((id(c), id(o)))
+    if (id(c), id(o)) not in b.said_another:
+        b.said_another.add((id(c), id(o)))
         b.log(
             "survey: the %.0f x %.0f mm sherd at (%.3f, %.3f) m is another colour (%.0f apart "
             "in a*, b*) than the %.0f x %.0f mm one seen at (%.3f, %.3f) m: not it seen again"
