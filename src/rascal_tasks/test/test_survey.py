@@ -6,6 +6,7 @@ cut sherds as the image border does)."""
 
 import math
 from dataclasses import replace
+from functools import partial
 from types import SimpleNamespace
 
 import pytest
@@ -20,6 +21,7 @@ from rascal_tasks.survey import (
     describe_leftover,
     lawnmower,
     look_for,
+    may_stand_for,
     reachable_look_yaws,
     seen_apart,
     taken_off_the_mat,
@@ -168,7 +170,9 @@ def _batch(leftovers=()):
         config={"recovery": {"search_radius": 0.06}},
         leftovers=list(leftovers),
         not_seen_again=[],
+        said_another=set(),
         event=lambda seq, kind, detail: events.append(kind),
+        log=lambda line: None,
     )
     return b, events
 
@@ -220,15 +224,14 @@ def test_a_sherd_of_another_colour_does_not_stand_for_one_not_seen_again():
     under = replace(_seen(0.270, 0.210, 0.057), width=0.039, height=0.010, colour=red)
     assert surely_another(under, top)
 
-    def alike(c, o):  # as survey.account_for_vanished asks
-        return c.length >= 0.75 * o.length and not surely_another(c, o)
-
     b, events = _batch()
+    alike = partial(may_stand_for, b)
     look_for(b, PUSHED_OFF, [(top.x, top.y, top)], [under], alike, lambda o, r: "")
     assert events == [PUSHED_OFF]
     # it slid off onto the mat beside: seen there, its colour, nothing said
     slid = replace(top, x=0.30, y=0.200, height=0.012, support=0.0)
     b, events = _batch()
+    alike = partial(may_stand_for, b)
     look_for(b, PUSHED_OFF, [(top.x, top.y, top)], [under, slid], alike, lambda o, r: "")
     assert events == []
     # of a colour like its own (a bag's sherds of one ware), or no colour told: not surely

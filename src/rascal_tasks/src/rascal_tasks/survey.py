@@ -244,6 +244,15 @@ def _surely_another(b, c, o: Observation) -> bool:
     return True
 
 
+def may_stand_for(b, c, o: Observation) -> bool:
+    """Whether `c`, seen now, may be `o`, seen near the mat's edge before, seen again: anything
+    perception does not offer (a leftover), or a sherd at least about as long (uncovered since,
+    it shows more of itself) that is not of another colour."""
+    if isinstance(c, Leftover):
+        return True
+    return c.length >= (1.0 - SAME_SIZE) * o.length and not _surely_another(b, c, o)
+
+
 def account_for_vanished(b, found: List[Observation]):
     """Each sherd of the survey before (`b.seen`) lying near the mat's edge that was not taken
     off the mat since (`b.taken_since_survey`: where the survey saw each sherd taken) must be
@@ -267,8 +276,7 @@ def account_for_vanished(b, found: List[Observation]):
         PUSHED_OFF,
         near,
         found,
-        lambda c, o: isinstance(c, Leftover)
-        or (c.length >= (1.0 - SAME_SIZE) * o.length and not _surely_another(b, c, o)),
+        lambda c, o: may_stand_for(b, c, o),
         lambda o, radius: "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge "
         "was not picked up and is not seen within %.0f mm of there since: a grasp beside it may "
         "have pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
