@@ -242,6 +242,17 @@ def test_the_fingertip_pads_layout_passes_with_the_shipped_one_station_layout_to
     assert load_config(SHIPPED)["arm"]["gripper"]["fingertip_pads"] == 0.0
 
 
+def test_the_turned_stations_layout_passes_alone_and_over_the_one_station_layout():
+    """config/layouts/turned_stations.yaml (bench/heap's askew table): every station turned, no
+    overlap, every marker on the bare table, the scale's platform under the turned camera."""
+    turned = os.path.join(WORKSPACE, "config", "layouts", "turned_stations.yaml")
+    for over in ([turned], [ONE_STATION, turned]):
+        stations = load_config(SHIPPED, over=over).stations
+        assert all(s.area.yaw != 0.0 for s in stations.values())
+    camera = stations["camera"]
+    assert camera.over_scale and camera.area.contains(stations["scale"].area)
+
+
 def test_a_turned_station_turns_its_area_and_what_stands_on_it(shipped):
     """`stations.<name>.yaw`: the pickup mat turned 5° keeps its centre; its corners, what lies
     on it and the survey's views turn with it, and its markers' offsets are in its frame."""
