@@ -20,7 +20,7 @@ from rascal_tasks.failures import LOSE_SHERD, STOP, SherdFailure, classify
 from rascal_tasks.pickup import miss_spot
 from rascal_tasks.rig import Leftover, Observation, RigError
 from rascal_tasks.run_batch import what_is_left
-from rascal_tasks.selection import among_others
+from rascal_tasks.selection import among_others, taken_again
 from rascal_tasks.singulation import topple_direction, was_pushed
 from rascal_tasks.stations import DiscardStation
 from rascal_tasks.survey import describe_leftover
@@ -339,6 +339,22 @@ def test_a_slipped_sherd_seen_by_a_later_survey_is_no_longer_said(config):
     assert rec.status() == {1: "done", 2: "done"} and b.station == "discard"
     assert batch.not_seen_again == [] and what_is_left(batch, []) == ""
     assert any(line.startswith("batch seen_again:") for line in said), said
+
+
+def test_a_sherd_partly_under_another_held_again_where_it_slipped_is_the_one_that_slipped():
+    # heap_22_corner seed 85: seen 55 x 23 mm partly under another, it slipped while lifted and
+    # was held again at once, seen 51 x 17 mm: that is it (it falls back where it lay), not a
+    # sherd the survey after must find
+    slipped = Observation(0.051, 0.195, 0.0, 0.0554, 0.0234, 0.008, 0.051, 0.195, 0.01, 0.0, 0.04)
+    slipped = replace(slipped, covered=0.48)
+    again = replace(slipped, x=0.054, length=0.0506, width=0.0160, covered=0.47)
+    assert taken_again(again, slipped)
+    # seen whole both times, a sherd of another size held there is another sherd
+    whole = replace(slipped, covered=0.0)
+    assert not taken_again(replace(again, covered=0.0), whole)
+    assert taken_again(replace(whole, x=0.09), whole)  # of its size: it, wherever it fell
+    # partly covered, but held elsewhere than where it lay: not it
+    assert not taken_again(replace(again, x=0.09), slipped)
 
 
 def test_a_sherd_that_slips_out_while_lifted_and_falls_near_is_picked_again(config):

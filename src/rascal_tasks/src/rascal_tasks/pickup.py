@@ -10,7 +10,13 @@ from rascal_tasks.manipulation import grasp_retrying, holdable, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
-from rascal_tasks.selection import SAME_SHERD, among_others, covered, itself, same_size
+from rascal_tasks.selection import (
+    SAME_SHERD,
+    among_others,
+    covered,
+    itself,
+    taken_again,
+)
 from rascal_tasks.survey import reachable_look_yaws, survey_at
 from rascal_tasks.wrist import route_yaw, same_grasp_yaws
 
@@ -43,7 +49,7 @@ class Pickup(BatchState):
         o, tries, held = grasp_retrying(b, o, b.pickup, taken_for=surveyed)
         # a sherd that slipped out while lifted has no number yet: the next survey must see it
         # again (survey.account_for_slips), unless the retry took it at once
-        b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and same_size(o, s))]
+        b.unchecked_slips += [s for s in b.lift_slips[slips:] if not (held and taken_again(o, s))]
         if held:
             if b.renumber is not None:  # two were put back: this one takes over that number
                 b.sherd, b.renumber = b.renumber, None

@@ -114,6 +114,18 @@ def covered(o: Observation) -> bool:
     return o.covered > COVERED
 
 
+def taken_again(o: Observation, slipped: Observation) -> bool:
+    """Whether `o`, held by the grasp after `slipped` slipped out of the fingers while lifted
+    (it falls back where it lay), is that sherd: of its size, or, where either was seen partly
+    under another (its size is of the part that shows, and changes as it falls back), where it
+    lay (heap_22_corner seed 85: a sherd seen 55 x 23 mm slipped, was held again at once seen
+    51 x 17 mm, and was recorded; the survey after it then said it slipped away, exit 1)."""
+    if same_size(o, slipped):
+        return True
+    partly = covered(o) or covered(slipped)
+    return partly and o.distance_to(slipped.x, slipped.y) <= SAME_SHERD
+
+
 def turned(o: Observation) -> bool:
     """Whether its grasp is turned off its minor axis (TURNED)."""
     return abs(o.grasp_turn) > TURNED
