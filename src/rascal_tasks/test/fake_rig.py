@@ -57,6 +57,8 @@ class Sherd:
     # [rad] perception turns its grasp this far off closing across its width (neighbours in
     # the way): the detection's grasp_yaw
     grasp_turn: float = 0.0
+    # the share of its outline perception sees under another sherd (the detection's covered)
+    covered: float = 0.0
 
     @property
     def chord(self) -> float:
@@ -364,6 +366,7 @@ class _Perception(rig.Perception):
                 s.width + 0.012,
                 thickness=s.thickness + s.lifted_wall,
                 support=s.support,
+                covered=s.covered,
             )
             for s in self._in_view(station)
             if self._pickable(s)

@@ -193,6 +193,45 @@ def test_a_sherd_dropped_from_a_grasp_turned_amid_others_waits_for_them(config):
     assert any(n.startswith("recovered: picked up again") for n in rec.sherds[1].notes)
 
 
+def test_a_sherd_dropped_again_by_its_turned_grasp_amid_others_is_pushed_apart(config):
+    """heap_22_corner seed 85: a, grasped along its length amid others, slipped out on its way,
+    was put off for after them, and was picked again before them (they lay partly under
+    others: `covered`), to slip again; grasped so a third time it would slip on (seven grasps,
+    three drops). Dropped so a second time it is pushed apart from its neighbours instead, and
+    taken from the survey after; every sherd recorded once."""
+    turned = math.pi / 2
+    world = World(
+        config,
+        [
+            Sherd("a", 0.10, 0.22, grasp_turn=turned),
+            Sherd("c", 0.16, 0.22, grasp_turn=turned, covered=0.3),
+        ],
+    )
+    world.slips["a"] = (0.11, 0.22)
+    world.slips_again["a"] = 1  # twice: then it holds
+    said = []
+    rec = Recorder()
+    batch = workflow.Batch(config, world.rig(), rec, context="T", log=said.append)
+    assert workflow.build_machine(batch).execute() == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    pushes = [line for line in said if line.startswith("batch pushed:")]
+    assert len(pushes) == 1 and "at (0.110, 0.220) m" in pushes[0], said
+    assert "slipped out of the fingers twice on its way, grasped 90 deg" in pushes[0]
+    assert sum(r.drops for r in rec.sherds.values()) == 2
+    assert any(
+        "pushed apart from its neighbours" in n for r in rec.sherds.values() for n in r.notes
+    )
+    # alone on the mat when dropped again, nothing is in the way to push it from: grasped again
+    world = World(config, [Sherd("a", 0.10, 0.22, grasp_turn=turned)])
+    world.slips["a"] = (0.11, 0.22)
+    world.slips_again["a"] = 1
+    said = []
+    rec = Recorder()
+    batch = workflow.Batch(config, world.rig(), rec, context="T", log=said.append)
+    assert workflow.build_machine(batch).execute() == "finished"
+    assert rec.status() == {1: "done"} and not any("pushed" in line for line in said)
+
+
 def test_a_sherd_that_slips_out_as_often_twice_over_is_left_for_a_person(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
     world.slips["a"] = (0.11, 0.22)

@@ -9,7 +9,7 @@ from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying, holdable, openings
 from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.singulation import MAX_PUSHES, PUSH, push, push_direction, was_pushed
+from rascal_tasks.singulation import part_from_neighbours
 from rascal_tasks.selection import (
     SAME_SHERD,
     among_others,
@@ -89,25 +89,12 @@ class Pickup(BatchState):
         return "missed"
 
     def singulate(self, o, others, key) -> bool:
-        """Failed twice here: push it apart from its neighbours, once per spot and once per sherd
-        (singulation.py), if the batch has pushes left and a push keeps it on the mat. True when
-        it was pushed."""
-        b = self.batch
-        if key in b.pushed or len(b.pushed) >= MAX_PUSHES or was_pushed(b, o):
-            return False
-        b.pushed.add(key)
-        d = push_direction(o, others, b.pickup.area)
-        if d is None or not push(b, o, d):
-            return False
-        b.pushed_to.append(((o.x + PUSH * d[0], o.y + PUSH * d[1]), o))
-        b.event(
-            None,
-            "pushed",
-            "sherd at (%.3f, %.3f) m pushed %.0f mm towards (%.2f, %.2f) after %d failed "
-            "grasps, to part it from its neighbours"
-            % (o.x, o.y, PUSH * 1000, d[0], d[1], 2 * b.config["recovery"]["max_grasp_attempts"]),
+        """Failed twice here: pushed apart from its neighbours (singulation.part_from_neighbours).
+        True when it was pushed."""
+        attempts = self.batch.config["recovery"]["max_grasp_attempts"]
+        return part_from_neighbours(
+            self.batch, o, others, key, "after %d failed grasps" % (2 * attempts)
         )
-        return True
 
     def left_unheld(self, o: Observation) -> str:
         """Shorter than the fingers close: no chord of it can be held, so it is left at once and

@@ -6,9 +6,11 @@ import math
 
 from rascal_tasks.batch import BatchState
 from rascal_tasks.manipulation import grasp_retrying
+from rascal_tasks.pickup import miss_spot
 from rascal_tasks.rig import Observation
 from rascal_tasks.selection import slipped_here, turned
 from rascal_tasks.sherd_record import SherdRecord
+from rascal_tasks.singulation import part_from_neighbours
 from rascal_tasks.survey import survey_at, survey_pickup_area
 
 
@@ -66,6 +68,13 @@ class Recover(BatchState):
         it = min(candidates, key=like_it)
         if self.turned_amid_others(s, station, it, candidates):
             return self.taken_later(s, it)
+        if self.pushed_apart(s, station, it, candidates):
+            return self.returned(
+                s,
+                "dropped again on its way from the pickup mat by a grasp turned %.0f deg off its "
+                "width" % abs(math.degrees(it.grasp_turn)),
+                "pushed apart from its neighbours at (%.3f, %.3f) m" % (it.x, it.y),
+            )
         o, tries, held = grasp_retrying(b, it, station, like=like_it)
         if not held:
             why = "found but could not be picked up (%d grasps)" % tries
@@ -127,6 +136,29 @@ class Recover(BatchState):
         if not any(c is not it for c in candidates):
             return False  # nothing to take first: nothing will clear its neighbours
         return not slipped_here(it, b.slipped_from)
+
+    def pushed_apart(self, s: SherdRecord, station, it: Observation, candidates) -> bool:
+        """Whether `s`, not measured yet, dropped back onto the pickup mat by a grasp turned amid
+        its neighbours after it was put off so once (turned_amid_others) and picked again before
+        they were gone, was pushed apart from them (singulation.part_from_neighbours) instead of
+        grasped so a third time. heap_22_corner seed 85: a sherd lying on another, seen as a
+        50 x 17 mm part of itself, 48 % covered, was grasped along its length seven times at
+        slip chances 0.80-0.90 (three drops) before it held; a push takes a sherd off the one
+        it lies on, and the next survey sees both apart."""
+        b = self.batch
+        if station is not b.pickup or s.station_index >= 0 or not turned(it):
+            return False
+        if not slipped_here(it, b.slipped_from):
+            return False
+        others = [c for c in candidates if c is not it]
+        return bool(others) and part_from_neighbours(
+            b,
+            it,
+            others,
+            miss_spot(b, it),
+            "after it slipped out of the fingers twice on its way, grasped %.0f deg off its width"
+            % abs(math.degrees(it.grasp_turn)),
+        )
 
     def taken_later(self, s: SherdRecord, it: Observation) -> str:
         """`s` (turned_amid_others) left on the mat for after the others: its number goes to

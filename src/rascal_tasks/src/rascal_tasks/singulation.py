@@ -76,6 +76,26 @@ def push(b, o: Observation, d: Tuple[float, float]) -> bool:
     return _sweep(b, (o.x, o.y), start, end, o.grasp_z, math.atan2(d[1], d[0]))
 
 
+def part_from_neighbours(b, o: Observation, others: List[Observation], key, after: str) -> bool:
+    """Push `o` apart from its neighbours (`others`), once per spot (`key`, rounded (x, y)) and
+    once per sherd (was_pushed), if the batch has pushes left (MAX_PUSHES) and a push keeps it
+    on the mat; said, `after` saying why. True when it was pushed."""
+    if key in b.pushed or len(b.pushed) >= MAX_PUSHES or was_pushed(b, o):
+        return False
+    b.pushed.add(key)
+    d = push_direction(o, others, b.pickup.area)
+    if d is None or not push(b, o, d):
+        return False
+    b.pushed_to.append(((o.x + PUSH * d[0], o.y + PUSH * d[1]), o))
+    b.event(
+        None,
+        "pushed",
+        "sherd at (%.3f, %.3f) m pushed %.0f mm towards (%.2f, %.2f) %s, to part it from its "
+        "neighbours" % (o.x, o.y, PUSH * 1000, d[0], d[1], after),
+    )
+    return True
+
+
 def was_pushed(b, o: Observation) -> bool:
     """Whether `o` is a sherd pushed before (one of its size lying about where a push sent it):
     pushed once and still not picked, it is a person's job (another push would chase it
