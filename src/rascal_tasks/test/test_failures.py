@@ -624,6 +624,12 @@ def test_a_sherd_picked_where_two_were_put_back_is_looked_at_and_flagged_if_stil
     on_one = replace(o, x=0.205, support=0.006)
     assert not among_others(o, [on_one])
     assert among_others(o, [replace(on_one, x=0.24, length=0.03, width=0.02)])
+    # lying on another with a wall thicker than a body sherd's, the sherd under it may be part
+    # of its outline, within the fingers' reach (heap_22_corner seed 84: both weighed as one)
+    thick = replace(o, support=0.0084, thickness=0.0172)
+    assert among_others(thick, [thick])
+    assert not among_others(replace(thick, thickness=0.007), [replace(thick, thickness=0.007)])
+    assert not among_others(replace(thick, support=0.0), [replace(thick, support=0.0)])
     world = fake_rig.riding_world(config)
     outcome, batch, recorder = _run(config, world)
     assert outcome == "finished" and batch.put_back_at  # the first put back's spots
@@ -712,7 +718,7 @@ def test_a_sherd_whose_mass_doubts_its_wall_and_seen_alone_is_taken_up_high_on_i
     outcome, batch, recorder = _run(config, world)
     assert outcome == "finished" and ("scale", high) not in grasps, grasps
     assert any(st == "scale" for st, _ in grasps), grasps
-    # a 16 mm wall, thicker than a body sherd's (manipulation.THICK_WALL), its mass no reason
+    # a 16 mm wall, thicker than a body sherd's (selection.THICK_WALL), its mass no reason
     # to doubt it and not looked at: taken up high on its edge by its wall seen on the mat
     grasps.clear()
     world = World(config, [Sherd("a", 0.10, 0.22, height=0.018, thickness=0.016, mass=0.04)])

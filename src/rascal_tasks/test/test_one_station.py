@@ -105,7 +105,7 @@ def test_a_sherd_left_on_the_scale_is_taken_to_the_mat_before_the_batch_ends(con
 
 
 def test_what_a_thick_sherd_taken_up_high_leaves_on_the_pan_is_weighed_out_of_its_row(config):
-    # a 16 mm wall is thicker than a body sherd's (manipulation.THICK_WALL): two seen as one,
+    # a 16 mm wall is thicker than a body sherd's (selection.THICK_WALL): two seen as one,
     # perhaps, so it is taken up high on its edge, and the pan is read, waited for, before its
     # row is done: what stayed there comes out of the row by difference (heap_20 seed 59: the
     # one left was weighed over by the next sherd and the row kept both masses)

@@ -11,7 +11,7 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.failures import SherdFailure, about_this_sherd
 from rascal_tasks.rig import Observation, RigError
-from rascal_tasks.selection import STACKED
+from rascal_tasks.selection import STACKED, THICK_WALL
 from rascal_tasks.survey import survey_at, taken_off_the_mat
 from rascal_tasks.wrist import route_yaw
 
@@ -23,10 +23,6 @@ FINGERTIP_OFFSET = urdf_model.fingertip_offset()
 # [m] the thinnest sherd wall (fine ware, facts/sherds_and_colour.md): a sherd lying on a
 # station is at least this high where the fingers close
 MIN_WALL = 0.003
-# [m] thicker than a body sherd's wall usually is (body 5-10 mm, typical 6-8 mm: facts/
-# sherds_and_colour.md §2, [S15]): seen from above, such a wall may be two sherds lying one
-# wholly on the other, so the sherd is taken up on a station high on its edge (rider_z)
-THICK_WALL = 0.010
 # [m] fingers this much short of the opening they were sent to stopped on something: the
 # controller calls a finger within 0.5 mm of its target there (GripperMonitor::kFingerReached)
 RELEASE_SLACK = 0.002

@@ -27,6 +27,11 @@ SAME_SHERD = 0.02
 # [m] a sherd whose support (what it lies on, above the station surface) is higher lies on
 # another sherd (the detector's StackSplitter steps by at least a wall, 2.5 mm)
 STACKED = 0.002
+# [m] thicker than a body sherd's wall usually is (body 5-10 mm, typical 6-8 mm: facts/
+# sherds_and_colour.md §2, [S15]): seen from above, such a wall may be two sherds lying one
+# wholly on the other, so the sherd is looked at on a station and taken up there high on its
+# edge (manipulation.rider_z)
+THICK_WALL = 0.010
 # Two mean colours of one sherd differ by less than this in CIELAB a*, b* (its chromaticity:
 # shading, a shadow, a neighbour's reflection change L* more than hue and chroma; wares of the
 # generator's and the field's chips, facts sherds_and_colour.md §2d, 2.5YR 5/6 against
@@ -98,8 +103,14 @@ def among_others(o: Observation, seen: list, put_back_at=()) -> bool:
     (10 g on 29 g, heap_mixed_20 seed 51). A neighbour merely beside it is not: looking after
     every sherd within 10 mm of one took 17 looks in 20 sherds of heap_20 seed 45, none seeing
     two. A sherd's own survey detection is not its neighbour (lying on another, it counted as
-    one resting on it: 16 looks in 20 sherds of heap_20 seed 58, none seeing two)."""
+    one resting on it: 16 looks in 20 sherds of heap_20 seed 58, none seeing two). But one
+    lying on something whose wall reads thicker than a body sherd's (THICK_WALL) may be lying
+    wholly on a sherd the grasp reaches: heap_22_corner seed 84, a 56 x 38 mm sherd seen with
+    a 17.2 mm wall on 8.4 mm lay on a 46 x 34 mm one that the fingers closed on, and both were
+    weighed as one row (34.9 g: within the mass bound of that wall)."""
     if o.covered > 0.0 or not o.grasp_clear:
+        return True
+    if o.support > STACKED and o.thickness > THICK_WALL:
         return True
     if any(o.distance_to(x, y) < o.length for x, y in put_back_at):
         return True
