@@ -344,6 +344,15 @@ def test_a_standing_sherd_falls_towards_the_middle_of_the_mat_and_away_from_othe
     # standing astride the mat's edge (a heap run left one 8 mm inside it): laid inwards
     astride = Leftover(cx, cy - sy / 2 + 0.008, 0.05, 0.012, "", 0.0, 0.0, 0.033, True)
     assert topple_direction(astride, [], area) == pytest.approx((0.0, 1.0))
+    # standing 2 mm from the mat's end, its long side out across it (heap_22_corner seed 84:
+    # left standing, exit 1): laid along the end, inwards, no farther out than it stands
+    sx = area.size[0]
+    at_end = Leftover(cx + sx / 2 - 0.002, cy + 0.05, 0.048, 0.015, "", 0.0, 0.0, 0.041, True)
+    assert topple_direction(at_end, [], area) == pytest.approx((0.0, -1.0))
+    # in the mat's corner as well: laid inwards from the side, along the end
+    assert topple_direction(replace(at_end, y=cy + sy / 2 - 0.002), [], area) == pytest.approx(
+        (0.0, -1.0)
+    )
 
 
 def test_a_sherd_that_slips_out_while_lifted_and_vanishes_is_said(config):

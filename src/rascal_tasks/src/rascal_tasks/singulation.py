@@ -48,14 +48,23 @@ def push_direction(
     return _roomiest(o, directions, PUSH, o.length / 2 + EDGE, others, area)
 
 
-def _roomiest(it, directions, travel, half, others, area) -> Optional[Tuple[float, float]]:
+def _roomiest(
+    it, directions, travel, half, others, area, hold_ground=False
+) -> Optional[Tuple[float, float]]:
     """Of `directions`, the one that moves `it` by `travel` farthest from the outlines of
-    `others` (their centres less half their length), `half` of it still inside `area`."""
+    `others` (their centres less half their length), `half` of it still inside `area`; or,
+    `hold_ground`, along each side of the mat no nearer its edge than it is now (a standing
+    sherd laid along an edge it stands near lands no farther out than it stands)."""
+    start = area.to_local((it.x, it.y))
     best, best_room = None, -math.inf
     for d in directions:
         end = (it.x + travel * d[0], it.y + travel * d[1])
         local = area.to_local(end)
-        if any(abs(local[i]) > area.size[i] / 2 - half for i in (0, 1)):
+        if any(
+            abs(local[i]) > area.size[i] / 2 - half
+            and not (hold_ground and abs(local[i]) <= abs(start[i]) + 1e-9)
+            for i in (0, 1)
+        ):
             continue  # would leave the mat
         room = min(
             (math.hypot(end[0] - p.x, end[1] - p.y) - p.length / 2 for p in others if p is not it),
@@ -112,7 +121,7 @@ def topple_direction(lo: Leftover, others: List[Leftover], area) -> Optional[Tup
     if neither. Its near side stays where it stood, so one standing at the mat's edge is laid
     inwards, never further off."""
     across = [(-sign * math.sin(lo.yaw), sign * math.cos(lo.yaw)) for sign in (1.0, -1.0)]
-    return _roomiest(lo, across, lo.height, EDGE, others, area)
+    return _roomiest(lo, across, lo.height, EDGE, others, area, hold_ground=True)
 
 
 def topple(b, lo: Leftover, d: Tuple[float, float]) -> bool:
