@@ -130,12 +130,17 @@ class Recover(BatchState):
         `slipped_from`). heap_25_offcentre seed 71: a 62 x 32 mm sherd among others grasped
         along its length, slip chance 0.62, dropped three times in a row by the same grasp
         before it was taken after the others; once they are gone its grasp closes across."""
-        b = self.batch
-        if station is not b.pickup or s.station_index >= 0 or not turned(it):
+        return self._turned_amid(s, station, it, candidates) and not slipped_here(
+            it, self.batch.slipped_from
+        )
+
+    def _turned_amid(self, s: SherdRecord, station, it: Observation, candidates) -> bool:
+        """Whether `s`, not measured yet, lies on the pickup mat again as `it`, whose grasp is
+        turned off its minor axis (selection.turned), with other sherds there (nothing else
+        there: nothing will clear its neighbours)."""
+        if station is not self.batch.pickup or s.station_index >= 0 or not turned(it):
             return False
-        if not any(c is not it for c in candidates):
-            return False  # nothing to take first: nothing will clear its neighbours
-        return not slipped_here(it, b.slipped_from)
+        return any(c is not it for c in candidates)
 
     def pushed_apart(self, s: SherdRecord, station, it: Observation, candidates) -> bool:
         """Whether `s`, not measured yet, dropped back onto the pickup mat by a grasp turned amid
@@ -146,15 +151,14 @@ class Recover(BatchState):
         slip chances 0.80-0.90 (three drops) before it held; a push takes a sherd off the one
         it lies on, and the next survey sees both apart."""
         b = self.batch
-        if station is not b.pickup or s.station_index >= 0 or not turned(it):
+        if not self._turned_amid(s, station, it, candidates):
             return False
         if not slipped_here(it, b.slipped_from):
             return False
-        others = [c for c in candidates if c is not it]
-        return bool(others) and part_from_neighbours(
+        return part_from_neighbours(
             b,
             it,
-            others,
+            [c for c in candidates if c is not it],
             miss_spot(b, it),
             "after it slipped out of the fingers twice on its way, grasped %.0f deg off its width"
             % abs(math.degrees(it.grasp_turn)),
