@@ -411,7 +411,8 @@ TEST(SherdDetector, GeneratedScenesUnderFieldLighting) {
 }
 
 TEST(SherdDetector, SplitsTouchingPairs) {
-  int pairs = 0, split = 0;
+  // and a sherd beside a thicker one, cut apart from it by its neck, is not called covered by it
+  int pairs = 0, split = 0, covered = 0, detections = 0;
   for (unsigned seed = 101; seed <= 110; ++seed) {
     rascal_sim::Scenario sc = generated(seed, 6, 1.0, 5600, 0.2);
     for (size_t i = 0; i + 1 < sc.sherds.size(); i += 2) makeTouching(sc, i, i + 1);
@@ -419,6 +420,8 @@ TEST(SherdDetector, SplitsTouchingPairs) {
     SherdDetector d(config());
     const DetectionResult r = calibrateAndDetect(sc, f, d);
     if (seed <= 102) save("touching_" + std::to_string(seed), f, r);
+    for (const SherdDetection& s : r.sherds) covered += s.covered > 0.05;
+    detections += static_cast<int>(r.sherds.size());
     for (size_t i = 0; i + 1 < f.truth.size(); i += 2) {
       if (!fullyInView(f.truth[i], f.view) || !fullyInView(f.truth[i + 1], f.view)) continue;
       ++pairs;
@@ -442,9 +445,10 @@ TEST(SherdDetector, SplitsTouchingPairs) {
       }
     }
   }
-  std::printf("touching pairs: %d of %d split\n", split, pairs);
+  std::printf("touching pairs: %d of %d split; %d of %d sherds called covered\n", split, pairs, covered, detections);
   ASSERT_GE(pairs, 10);
   EXPECT_GE(split, 0.9 * pairs);
+  EXPECT_LE(covered, 0.05 * detections);
 }
 
 TEST(SherdDetector, BackgroundCalibratedInDimLightWorksInBrightLight) {
@@ -692,3 +696,58 @@ TEST(SherdDetector, AViewCloserThanTheSurveysMeasuresEverySherdsWallToo) {
 }
 
 TEST(Print, SurveyJoints) { const auto& q = rascal_perception_test::surveyJoints(); std::printf("survey joints: %.4f %.4f %.4f %.4f %.4f %.4f\n", q[0], q[1], q[2], q[3], q[4], q[5]); }
+
+TEST(StackedSherds, ASherdsEndOnAnothersIsSeenCoveringIt) {
+  // Pairs of sherds, the second dropped with its end 6-12 mm (its box) over the first's and settled (it
+  // tilts down to the mat): two outlines with a neck between them, which the segmenter cuts
+  // apart before the depth is looked at. The one under is covered (not to be picked first:
+  // heap_25_offcentre seed 70, a finger came down on the one on top, called 0 % covered),
+  // the one on top is not. Printed per pair; pairs whose true outlines overlap by less than
+  // 20 mm^2 (the top's corner over the other's) are not counted.
+  int pairs = 0, under_covered = 0, top_free = 0, tops = 0;
+  for (unsigned seed = 131; seed <= 140; ++seed) {
+    rascal_sim::Scenario sc = generated(seed, 6, 1.0, 5600, 0.0);
+    for (size_t i = 0; i + 1 < sc.sherds.size(); i += 2) {
+      rascal_sim::SherdSpec& low = sc.sherds[i];
+      rascal_sim::SherdSpec& top = sc.sherds[i + 1];
+      const rascal_sim::SherdGeometry gl = rascal_sim::SherdMeshBuilder::build(low);
+      const rascal_sim::SherdGeometry gt = rascal_sim::SherdMeshBuilder::build(top);
+      const Eigen::Vector2d along(std::cos(low.pose.z()), std::sin(low.pose.z()));
+      top.pose.z() = low.pose.z();
+      const double overlap = 0.006 + 0.003 * static_cast<double>(i / 2);
+      top.pose.head<2>() = low.pose.head<2>() + (0.5 * gl.box_size.x() + 0.5 * gt.box_size.x() - overlap) * along;
+      top.drop_height = gl.box_size.z() + 0.002;
+    }
+    const Frame f = render(sc, surveyJoints(), 1.5);
+    SherdDetector d(config());
+    const DetectionResult r = calibrateAndDetect(sc, f, d);
+    if (seed <= 132) save("end_over_" + std::to_string(seed), f, r);
+    for (size_t i = 0; i + 1 < f.truth.size(); i += 2) {
+      const Truth &low = f.truth[i], &top = f.truth[i + 1];
+      if (!fullyInView(low, f.view) || !fullyInView(top, f.view)) continue;
+      std::vector<cv::Point2f> a, b, hull_a, hull_b, both;
+      for (const Eigen::Vector2d& p : low.outline) a.emplace_back(p.x() * 1e3, p.y() * 1e3);
+      for (const Eigen::Vector2d& p : top.outline) b.emplace_back(p.x() * 1e3, p.y() * 1e3);
+      cv::convexHull(a, hull_a);
+      cv::convexHull(b, hull_b);
+      const float mm2 = cv::intersectConvexConvex(hull_a, hull_b, both);
+      for (const SherdDetection& s : r.sherds) {
+        if ((s.centre.head<2>() - low.centre).norm() < 0.4 * low.length) {
+          std::printf("seed %u pair %zu: overlap %.0f mm^2, the one under %.0f %% covered\n", seed, i / 2, mm2,
+                      100 * s.covered);
+          if (mm2 < 20.0f) continue;
+          ++pairs;
+          under_covered += s.covered > 0.05;
+        } else if ((s.centre.head<2>() - top.centre).norm() < 0.4 * top.length) {
+          ++tops;
+          top_free += s.covered <= 0.05;
+        }
+      }
+    }
+  }
+  std::printf("end over end: %d pairs, the one under covered in %d; %d of %d on top uncovered\n", pairs,
+              under_covered, top_free, tops);
+  ASSERT_GE(pairs, 12);
+  EXPECT_GE(under_covered, 0.9 * pairs);
+  EXPECT_GE(top_free, 0.9 * tops);
+}

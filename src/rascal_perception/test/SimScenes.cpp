@@ -116,7 +116,7 @@ int wholeLeftovers(const std::vector<rascal_perception::Leftover>& leftovers) {
                                         [](const rascal_perception::Leftover& l) { return !l.cut_by_border; }));
 }
 
-Frame render(const Scenario& scenario, const JointVector& q) {
+Frame render(const Scenario& scenario, const JointVector& q, double settle_s) {
   // one simulator per arm pose, reloaded with each scenario (building one costs more than a frame)
   static std::map<JointVector, std::unique_ptr<Simulator>> cache;
   std::unique_ptr<Simulator>& cached = cache[q];
@@ -129,6 +129,7 @@ Frame render(const Scenario& scenario, const JointVector& q) {
   }
   Simulator& sim = *cached;
   sim.load(scenario);
+  for (const double until = sim.time() + settle_s; sim.time() < until;) sim.step();
   WristFrame w = sim.renderWristFrame();
   Frame f;
   f.rgb = w.rgb;

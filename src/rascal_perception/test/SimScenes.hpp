@@ -55,8 +55,9 @@ rascal_sim::JointVector pointDown(double x, double y, double z);
 rascal_sim::JointVector cameraOver(const Eigen::Vector2d& goal, double ee_z = 0.25);
 /// Survey joints over the pickup mat (computed once).
 const rascal_sim::JointVector& surveyJoints();
-/// Renders one wrist frame of `scenario` at joints q (no physics steps: sherds rest where spawned).
-Frame render(const rascal_sim::Scenario& scenario, const rascal_sim::JointVector& q);
+/// Renders one wrist frame of `scenario` at joints q, after `settle_s` seconds of physics (none:
+/// sherds rest where spawned).
+Frame render(const rascal_sim::Scenario& scenario, const rascal_sim::JointVector& q, double settle_s = 0.0);
 /// A generated scenario on the pickup mat.
 rascal_sim::Scenario generated(unsigned seed, int count, double brightness, double kelvin, double shadow,
                                int touching_pairs = 0);

@@ -14,7 +14,9 @@ namespace rascal_perception {
 
 struct StackPart {
   Blob blob;
-  double covered = 0.0;  ///< [1] share of its edge that runs under a higher part of the same blob
+  /// [1] share of its edge that runs under a higher part of the same blob, or under the edge of
+  /// a neighbour seen on it (an island the steps cut off, too small to be a sherd)
+  double covered = 0.0;
   double support = 0.0;  ///< [m] height above the plane of the parts it rests on (0: the table)
 };
 
@@ -32,6 +34,15 @@ class StackSplitter {
   /// The parts of `blob` (one part, uncovered, when it shows no step that cuts it apart).
   /// `height` is heightMap's image; empty: the blob as it is.
   std::vector<StackPart> split(const Blob& blob, const cv::Mat& height, const StackOptions& options) const;
+  /// For each of `parts` (of every blob of a frame; `group`: which blob each came from), the
+  /// share of its outline that runs under a part of another blob lying on it: a sherd's end on
+  /// another's, the two cut apart by the segmenter's neck split before the depth was looked at
+  /// (split() relates only the parts of one blob). Lying on it, not beside it: higher along the
+  /// shared edge and its underside there (its top less its measured wall, `walls` [m]; 0: not
+  /// measured, never taken to lie on another) up near the part's top. 0 without `height`.
+  static std::vector<double> coveredAcross(const std::vector<const Blob*>& parts, const std::vector<int>& group,
+                                           const std::vector<double>& walls, const cv::Mat& height,
+                                           const StackOptions& options);
 };
 
 }  // namespace rascal_perception

@@ -312,8 +312,10 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
     if (l.on_edge && l.why.find("edge") == std::string::npos) l.why += "; taller than wide: standing on its edge?";
     r.leftovers.push_back(std::move(l));
   };
-  for (const Blob& b : blobs) {
-    const std::vector<StackPart> parts = stacks_.split(b, height, stack);
+  std::vector<Blob> offered;  // the outline of each of r.sherds, and the blob it was cut from
+  std::vector<int> group;
+  for (size_t blob = 0; blob < blobs.size(); ++blob) {
+    const std::vector<StackPart> parts = stacks_.split(blobs[blob], height, stack);
     r.splits += static_cast<int>(parts.size()) - 1;
     for (const StackPart& part : parts) {
       if (!depth_mm.empty()) {
@@ -356,7 +358,20 @@ DetectionResult SherdDetector::detect(const std::string& station, const cv::Mat&
       around.own = &part.blob;
       planner_.plan(d, &around);
       r.sherds.push_back(std::move(d));
+      offered.push_back(part.blob);
+      group.push_back(static_cast<int>(blob));
     }
+  }
+  {
+    // and under the edge of a neighbour the segmenter cut apart from it
+    std::vector<const Blob*> outlines;
+    std::vector<double> walls;
+    for (size_t k = 0; k < r.sherds.size(); ++k) {
+      outlines.push_back(&offered[k]);
+      walls.push_back(r.sherds[k].thickness);
+    }
+    const std::vector<double> across = StackSplitter::coveredAcross(outlines, group, walls, height, stack);
+    for (size_t k = 0; k < r.sherds.size(); ++k) r.sherds[k].covered += across[k];
   }
   r.rejected_border = stats.rejected_border;
   r.rejected_size += stats.rejected_size;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <utility>
 #include <opencv2/imgproc.hpp>
 
 #include "rascal_perception/SherdSegmenter.hpp"
@@ -15,11 +16,54 @@ constexpr int kPad = 6;        ///< [px] looked at around the blob (its neighbou
 constexpr int kReach = 2;      ///< [px] a step is measured between pixels 2 * kReach apart
 constexpr int kBand = 3;       ///< [px] either side of a shared edge, compared for which part is higher
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+/// a piece the steps cut off is an island (a neighbour's edge, or noise) if at least this
+/// fraction (1/k) of the least part's area; smaller ones are ignored
+constexpr int kIslandShare = 8;
+/// a neighbour of another blob higher along a shared edge lies on the part there if its
+/// underside is at least this fraction of the part's top height up (the rest: a concave-up
+/// neighbour's rim, raised by its curvature, and the depth camera's millimetre)
+constexpr float kRestsOn = 0.5f;
 
 float median(std::vector<float>& v) {
   if (v.empty()) return kNaN;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
+}
+
+/// The heights either side of the edge between the pieces `a` and `b` (masks over `h`;
+/// `near_a`/`near_b`: each dilated by kBand): medians of a's pixels near b and of b's near a.
+struct EdgeHeights {
+  float a = kNaN, b = kNaN;  ///< [m]
+  /// +1 when b is higher by half a step, -1 when a is, 0 when neither (or either has no height)
+  int higher(float step) const {
+    if (!(a == a && b == b)) return 0;
+    return b > a + step / 2 ? 1 : a > b + step / 2 ? -1 : 0;
+  }
+};
+
+EdgeHeights edgeHeights(const cv::Mat& h, const cv::Mat& a, const cv::Mat& b, const cv::Mat& near_a,
+                        const cv::Mat& near_b) {
+  std::vector<float> ha, hb;
+  const cv::Mat ba = a & near_b, bb = b & near_a;
+  for (int y = 0; y < h.rows; ++y) {
+    for (int x = 0; x < h.cols; ++x) {
+      const float v = h.at<float>(y, x);
+      if (v != v) continue;
+      if (ba.at<uint8_t>(y, x)) ha.push_back(v);
+      if (bb.at<uint8_t>(y, x)) hb.push_back(v);
+    }
+  }
+  return {median(ha), median(hb)};
+}
+
+const cv::Mat& bandKernel() {
+  static const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kBand + 1, 2 * kBand + 1));
+  return k;
+}
+
+const cv::Mat& ringKernel() {
+  static const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  return k;
 }
 }  // namespace
 
@@ -90,75 +134,146 @@ std::vector<StackPart> StackSplitter::split(const Blob& blob, const cv::Mat& hei
   cores.setTo(0, edge);
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(cores, labels, stats, centroids, 4, CV_32S);
-  std::vector<int> keep;  // component labels big enough to be a sherd
+  // components big enough to be a sherd (parts), and islands: pieces the steps cut off that are
+  // too small to be one. An island higher than the part around it is the edge of a neighbour
+  // lying on it, the rest of that neighbour cut apart by the segmenter's neck split (a sherd's
+  // end over another's: heap_25_offcentre seed 70, a finger came down on the neighbour)
+  std::vector<int> keep, islands;
+  const int min_island = std::max(1, options.min_area_px / kIslandShare);
   for (int i = 1; i < n; ++i) {
-    if (stats.at<int>(i, cv::CC_STAT_AREA) >= options.min_area_px) keep.push_back(i);
+    const int area = stats.at<int>(i, cv::CC_STAT_AREA);
+    if (area >= options.min_area_px) {
+      keep.push_back(i);
+    } else if (area >= min_island) {
+      islands.push_back(i);
+    }
   }
-  if (keep.size() < 2) return whole;
-  // every other pixel of the blob goes to the part it is nearest to (grown 1 px at a time)
-  cv::Mat part(roi.size(), CV_32S, cv::Scalar(-1));
-  for (size_t k = 0; k < keep.size(); ++k) part.setTo(static_cast<int>(k), labels == keep[k]);
+  if (keep.empty() || (keep.size() == 1 && islands.empty())) return whole;
+  // every other pixel of the blob goes to the piece (part or island) it is nearest to (grown 1 px
+  // at a time)
+  const size_t pieces = keep.size() + islands.size();
+  cv::Mat piece(roi.size(), CV_32S, cv::Scalar(-1));
+  for (size_t k = 0; k < keep.size(); ++k) piece.setTo(static_cast<int>(k), labels == keep[k]);
+  for (size_t k = 0; k < islands.size(); ++k) piece.setTo(static_cast<int>(keep.size() + k), labels == islands[k]);
   for (bool grew = true; grew;) {
     grew = false;
-    cv::Mat next = part.clone();
+    cv::Mat next = piece.clone();
     for (int y = 0; y < mask.rows; ++y) {
       for (int x = 0; x < mask.cols; ++x) {
-        if (!mask.at<uint8_t>(y, x) || part.at<int>(y, x) >= 0) continue;
+        if (!mask.at<uint8_t>(y, x) || piece.at<int>(y, x) >= 0) continue;
         for (const cv::Point& d : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
           const cv::Point q(x + d.x, y + d.y);
-          if (q.x < 0 || q.y < 0 || q.x >= mask.cols || q.y >= mask.rows || part.at<int>(q) < 0) continue;
-          next.at<int>(y, x) = part.at<int>(q);
+          if (q.x < 0 || q.y < 0 || q.x >= mask.cols || q.y >= mask.rows || piece.at<int>(q) < 0) continue;
+          next.at<int>(y, x) = piece.at<int>(q);
           grew = true;
           break;
         }
       }
     }
-    part = next;
+    piece = next;
   }
-  std::vector<cv::Mat> masks(keep.size());
+  std::vector<cv::Mat> masks(pieces);
+  for (size_t k = 0; k < pieces; ++k) masks[k] = piece == static_cast<int>(k);
+  std::vector<cv::Mat> near(pieces), outline(pieces);
+  for (size_t k = 0; k < pieces; ++k) {
+    cv::dilate(masks[k], near[k], bandKernel());
+    cv::Mat grown;
+    cv::dilate(masks[k], grown, ringKernel());
+    outline[k] = grown & ~masks[k];  // the pixels just outside piece k
+  }
+  // an island belongs to the part it shares the longest edge with (to the first part if it
+  // touches only islands)
+  std::vector<int> home(pieces, 0);
+  for (size_t k = 0; k < keep.size(); ++k) home[k] = static_cast<int>(k);
+  for (size_t m = keep.size(); m < pieces; ++m) {
+    int longest = 0;
+    for (size_t k = 0; k < keep.size(); ++k) {
+      const int len = cv::countNonZero(outline[m] & masks[k]);
+      if (len > longest) longest = len, home[m] = static_cast<int>(k);
+    }
+  }
   std::vector<int> edge_px(keep.size(), 0), under_px(keep.size(), 0);
-  for (size_t k = 0; k < keep.size(); ++k) masks[k] = part == static_cast<int>(k);
   std::vector<StackPart> out(keep.size());
-  const cv::Mat band = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kBand + 1, 2 * kBand + 1));
-  const cv::Mat ring = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
-  std::vector<cv::Mat> near(keep.size());
-  for (size_t k = 0; k < keep.size(); ++k) cv::dilate(masks[k], near[k], band);
   for (size_t i = 0; i < keep.size(); ++i) {
-    cv::Mat grown, outline;
-    cv::dilate(masks[i], grown, ring);
-    outline = grown & ~masks[i];  // the pixels just outside part i
-    edge_px[i] = cv::countNonZero(outline);
-    for (size_t j = 0; j < keep.size(); ++j) {
+    edge_px[i] = cv::countNonZero(outline[i]);
+    for (size_t j = 0; j < pieces; ++j) {
       if (i == j) continue;
-      const cv::Mat shared = outline & masks[j];
-      const int len = cv::countNonZero(shared);
+      const int len = cv::countNonZero(outline[i] & masks[j]);
       if (len == 0) continue;
-      // which side of the shared edge is higher: i's pixels near j against j's pixels near i
-      std::vector<float> hi, hj;
-      const cv::Mat bi = masks[i] & near[j], bj = masks[j] & near[i];
-      for (int y = 0; y < mask.rows; ++y) {
-        for (int x = 0; x < mask.cols; ++x) {
-          const float v = h.at<float>(y, x);
-          if (v != v) continue;
-          if (bi.at<uint8_t>(y, x)) hi.push_back(v);
-          if (bj.at<uint8_t>(y, x)) hj.push_back(v);
-        }
-      }
-      const float mi = median(hi), mj = median(hj);
-      if (!(mi == mi && mj == mj)) continue;
-      if (mj > mi + step / 2) {
+      const EdgeHeights e = edgeHeights(h, masks[i], masks[j], near[i], near[j]);
+      const int side = e.higher(step);
+      if (side > 0) {
         under_px[i] += len;  // j lies on i along this edge
-      } else if (mi > mj + step / 2) {
-        out[i].support = std::max(out[i].support, static_cast<double>(mj));  // i lies on j
+      } else if (side < 0 && j < keep.size()) {
+        // i lies on part j (an island lower than i is not what it rests on: the mat's edge
+        // mixed into a thick sherd's outline reads low too)
+        out[i].support = std::max(out[i].support, static_cast<double>(e.b));
       }
     }
   }
   for (size_t k = 0; k < keep.size(); ++k) {
-    cv::Rect box = cv::boundingRect(masks[k]);
-    out[k].blob = SherdSegmenter::blobOf(masks[k](box), box.tl() + roi.tl());
     out[k].covered = edge_px[k] > 0 ? static_cast<double>(under_px[k]) / edge_px[k] : 0.0;
   }
+  if (keep.size() == 1) {
+    whole[0].covered = out[0].covered;  // one sherd with a neighbour's edge on it: its outline as it was
+    return whole;
+  }
+  for (size_t k = 0; k < keep.size(); ++k) {
+    cv::Mat own = masks[k].clone();
+    for (size_t m = keep.size(); m < pieces; ++m) {
+      if (home[m] == static_cast<int>(k)) own |= masks[m];
+    }
+    cv::Rect box = cv::boundingRect(own);
+    out[k].blob = SherdSegmenter::blobOf(own(box), box.tl() + roi.tl());
+  }
   return out;
+}
+
+std::vector<double> StackSplitter::coveredAcross(const std::vector<const Blob*>& parts, const std::vector<int>& group,
+                                                 const std::vector<double>& walls, const cv::Mat& height,
+                                                 const StackOptions& options) {
+  std::vector<double> covered(parts.size(), 0.0);
+  if (height.empty()) return covered;
+  const cv::Rect image(0, 0, height.cols, height.rows);
+  const cv::Size pad(2 * (kBand + 1), 2 * (kBand + 1));
+  const cv::Point shift(kBand + 1, kBand + 1);
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const cv::Rect around_i = (parts[i]->bounds + pad - shift) & image;
+    int edge_px = -1, under_px = 0;  // i's outline (counted once, when it has a neighbour)
+    for (size_t j = 0; j < parts.size(); ++j) {
+      if (i == j || group[i] == group[j] || (around_i & parts[j]->bounds).empty()) continue;
+      // both masks in one window around the two (and a band beyond)
+      const cv::Rect roi = ((parts[i]->bounds | parts[j]->bounds) + pad - shift) & image;
+      cv::Mat mi = cv::Mat::zeros(roi.size(), CV_8U), mj = cv::Mat::zeros(roi.size(), CV_8U);
+      parts[i]->mask.copyTo(mi(cv::Rect(parts[i]->bounds.tl() - roi.tl(), parts[i]->bounds.size())));
+      parts[j]->mask.copyTo(mj(cv::Rect(parts[j]->bounds.tl() - roi.tl(), parts[j]->bounds.size())));
+      cv::Mat grown;
+      cv::dilate(mi, grown, ringKernel());
+      const cv::Mat outline = grown & ~mi;
+      const int len = cv::countNonZero(outline & mj);
+      if (len == 0) continue;
+      cv::Mat near_i, near_j;
+      cv::dilate(mi, near_i, bandKernel());
+      cv::dilate(mj, near_j, bandKernel());
+      const cv::Mat h = height(roi);
+      const EdgeHeights e = edgeHeights(h, mi, mj, near_i, near_j);
+      // j lies on i there when its underside (its top less its wall) is up near i's top; a
+      // thicker sherd merely beside i has its underside on the table
+      if (e.higher(static_cast<float>(options.step)) > 0 && walls[j] > 0.0 && e.b - walls[j] >= kRestsOn * e.a) {
+        under_px += len;
+      }
+      if (edge_px < 0) {
+        // the outline of i alone: its mask padded by a pixel so the ring is not cut by its box
+        cv::Mat padded = cv::Mat::zeros(parts[i]->mask.rows + 2, parts[i]->mask.cols + 2, CV_8U);
+        parts[i]->mask.copyTo(padded(cv::Rect(1, 1, parts[i]->mask.cols, parts[i]->mask.rows)));
+        cv::Mat whole;
+        cv::dilate(padded, whole, ringKernel());
+        edge_px = cv::countNonZero(whole & ~padded);
+      }
+    }
+    if (edge_px > 0) covered[i] = static_cast<double>(under_px) / edge_px;
+  }
+  return covered;
 }
 
 }  // namespace rascal_perception

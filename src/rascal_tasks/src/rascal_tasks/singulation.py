@@ -89,9 +89,8 @@ def part_from_neighbours(b, o: Observation, others: List[Observation], key, afte
     """Push `o` apart from its neighbours (`others`), once per spot (`key`, rounded (x, y)) and
     once per sherd (was_pushed), if the batch has pushes left (MAX_PUSHES) and a push keeps it
     on the mat; said, `after` saying why. True when it was pushed."""
-    if key in b.pushed or len(b.pushed) >= MAX_PUSHES or was_pushed(b, o):
+    if was_pushed(b, o) or not _spend_push(b, key):
         return False
-    b.pushed.add(key)
     d = push_direction(o, others, b.pickup.area)
     if d is None or not push(b, o, d):
         return False
@@ -102,6 +101,16 @@ def part_from_neighbours(b, o: Observation, others: List[Observation], key, afte
         "sherd at (%.3f, %.3f) m pushed %.0f mm towards (%.2f, %.2f) %s, to part it from its "
         "neighbours" % (o.x, o.y, PUSH * 1000, d[0], d[1], after),
     )
+    return True
+
+
+def _spend_push(b, key) -> bool:
+    """Take one push from the batch's budget (MAX_PUSHES, pushes and topples together) for the
+    spot `key` (rounded (x, y)): False when that spot was pushed before or the budget is spent.
+    Spent before the push is tried, so a refused push is not tried again."""
+    if key in b.pushed or len(b.pushed) >= MAX_PUSHES:
+        return False
+    b.pushed.add(key)
     return True
 
 
@@ -163,10 +172,8 @@ def _push_over(b, lo, seen, area):
     """Push the standing sherd `lo` over, once per spot and within the push budget (MAX_PUSHES,
     shared with the heap's pushes): the direction it was pushed, or None (pushed there before,
     budget spent, no free side among `seen` in `area`, or the push failed)."""
-    key = (round(lo.x, 2), round(lo.y, 2))
-    if key in b.pushed or len(b.pushed) >= MAX_PUSHES:
+    if not _spend_push(b, (round(lo.x, 2), round(lo.y, 2))):
         return None
-    b.pushed.add(key)
     d = topple_direction(lo, seen, area)
     if d is None or not topple(b, lo, d):
         return None
