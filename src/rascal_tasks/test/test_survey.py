@@ -17,6 +17,7 @@ from rascal_tasks.rig import Leftover, Observation
 from rascal_tasks.run_batch import what_is_left
 from rascal_tasks.survey import (
     LOOK_BACK,
+    account_for_vanished,
     MAX_EXTRA_LOOKS,
     describe_leftover,
     lawnmower,
@@ -196,6 +197,32 @@ def test_one_thing_seen_stands_for_one_sherd_not_seen_again():
         b, PUSHED_OFF, [(o.x, o.y, o) for o in (a, f)], [a, f], lambda c, o: True, lambda o, r: ""
     )
     assert b.not_seen_again == []
+
+
+def test_a_sherd_still_lying_where_it_lay_does_not_stand_for_one_gone_from_beside_it():
+    # heap_25_offcentre seed 73: a 53 mm sherd dropped back 2 cm from the mat's far edge was
+    # flung off it by a grasp beside it; a 60 mm one mid-mat, 56 mm from it, lay there all
+    # along and stood for it: 24 rows for 25 sherds, exit 0, said nowhere
+    from rascal_tasks.config import Rect
+
+    lost = _seen(0.095, 0.309, 0.053)
+    mid = _seen(0.110, 0.255, 0.060)
+    b, events = _batch()
+    b.pickup = SimpleNamespace(area=Rect((0.16, 0.25), (0.30, 0.16)))
+    b.seen, b.taken_since_survey = [lost, mid], []
+    b.said_another = set()
+    account_for_vanished(b, [mid])
+    assert events == [PUSHED_OFF] and [(u.x, u.y) for u in b.not_seen_again] == [(lost.x, lost.y)]
+    # still there: nothing said
+    b.not_seen_again, b.taken_since_survey = [], []
+    events.clear()
+    account_for_vanished(b, [mid, replace(lost, x=0.097)])
+    assert events == []
+    # the one mid-mat moved (a grasp nudged it), the one near the edge uncovered since: a sherd
+    # at least about as long near where it lay may still be it, as before
+    b.taken_since_survey = []
+    account_for_vanished(b, [replace(mid, x=0.080, y=0.290)])
+    assert events == []
 
 
 def test_a_blob_of_several_sherds_seen_apart_since_is_not_asked_back_whole():
