@@ -65,6 +65,13 @@ const cv::Mat& ringKernel() {
   static const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
   return k;
 }
+
+/// The pixels just outside `mask` (its 8-neighbours not in it), within `mask`'s own size.
+cv::Mat outlineOf(const cv::Mat& mask) {
+  cv::Mat grown;
+  cv::dilate(mask, grown, ringKernel());
+  return grown & ~mask;
+}
 }  // namespace
 
 cv::Mat StackSplitter::heightMap(const cv::Mat& depth_mm, const CameraView& view, const Eigen::Vector4d& plane,
@@ -177,20 +184,7 @@ std::vector<StackPart> StackSplitter::split(const Blob& blob, const cv::Mat& hei
   std::vector<cv::Mat> near(pieces), outline(pieces);
   for (size_t k = 0; k < pieces; ++k) {
     cv::dilate(masks[k], near[k], bandKernel());
-    cv::Mat grown;
-    cv::dilate(masks[k], grown, ringKernel());
-    outline[k] = grown & ~masks[k];  // the pixels just outside piece k
-  }
-  // an island belongs to the part it shares the longest edge with (to the first part if it
-  // touches only islands)
-  std::vector<int> home(pieces, 0);
-  for (size_t k = 0; k < keep.size(); ++k) home[k] = static_cast<int>(k);
-  for (size_t m = keep.size(); m < pieces; ++m) {
-    int longest = 0;
-    for (size_t k = 0; k < keep.size(); ++k) {
-      const int len = cv::countNonZero(outline[m] & masks[k]);
-      if (len > longest) longest = len, home[m] = static_cast<int>(k);
-    }
+    outline[k] = outlineOf(masks[k]);
   }
   std::vector<int> edge_px(keep.size(), 0), under_px(keep.size(), 0);
   std::vector<StackPart> out(keep.size());
@@ -217,6 +211,17 @@ std::vector<StackPart> StackSplitter::split(const Blob& blob, const cv::Mat& hei
   if (keep.size() == 1) {
     whole[0].covered = out[0].covered;  // one sherd with a neighbour's edge on it: its outline as it was
     return whole;
+  }
+  // an island belongs to the part it shares the longest edge with (to the first part if it
+  // touches only islands)
+  std::vector<int> home(pieces, 0);
+  for (size_t k = 0; k < keep.size(); ++k) home[k] = static_cast<int>(k);
+  for (size_t m = keep.size(); m < pieces; ++m) {
+    int longest = 0;
+    for (size_t k = 0; k < keep.size(); ++k) {
+      const int len = cv::countNonZero(outline[m] & masks[k]);
+      if (len > longest) longest = len, home[m] = static_cast<int>(k);
+    }
   }
   for (size_t k = 0; k < keep.size(); ++k) {
     cv::Mat own = masks[k].clone();
@@ -247,10 +252,7 @@ std::vector<double> StackSplitter::coveredAcross(const std::vector<const Blob*>&
       cv::Mat mi = cv::Mat::zeros(roi.size(), CV_8U), mj = cv::Mat::zeros(roi.size(), CV_8U);
       parts[i]->mask.copyTo(mi(cv::Rect(parts[i]->bounds.tl() - roi.tl(), parts[i]->bounds.size())));
       parts[j]->mask.copyTo(mj(cv::Rect(parts[j]->bounds.tl() - roi.tl(), parts[j]->bounds.size())));
-      cv::Mat grown;
-      cv::dilate(mi, grown, ringKernel());
-      const cv::Mat outline = grown & ~mi;
-      const int len = cv::countNonZero(outline & mj);
+      const int len = cv::countNonZero(outlineOf(mi) & mj);
       if (len == 0) continue;
       cv::Mat near_i, near_j;
       cv::dilate(mi, near_i, bandKernel());
@@ -266,9 +268,7 @@ std::vector<double> StackSplitter::coveredAcross(const std::vector<const Blob*>&
         // the outline of i alone: its mask padded by a pixel so the ring is not cut by its box
         cv::Mat padded = cv::Mat::zeros(parts[i]->mask.rows + 2, parts[i]->mask.cols + 2, CV_8U);
         parts[i]->mask.copyTo(padded(cv::Rect(1, 1, parts[i]->mask.cols, parts[i]->mask.rows)));
-        cv::Mat whole;
-        cv::dilate(padded, whole, ringKernel());
-        edge_px = cv::countNonZero(whole & ~padded);
+        edge_px = cv::countNonZero(outlineOf(padded));
       }
     }
     if (edge_px > 0) covered[i] = static_cast<double>(under_px) / edge_px;
