@@ -502,6 +502,7 @@ def test_random_node_killed_mid_batch_then_rerun_records_each_sherd_once(rig_fac
             code, out = finish(proc, 120)
         except AssertionError as e:
             raise AssertionError("\n".join(report + [context, str(e), rig.tail(30)])) from None
+        killed_out = out  # what the killed run said: a row it wrote may be why a rerun fails
         note = (
             "%s killed after %.1f s: exit %s %.1f s later"
             % (victim, delay, code, time.monotonic() - t_kill)
@@ -538,6 +539,10 @@ def test_random_node_killed_mid_batch_then_rerun_records_each_sherd_once(rig_fac
         try:
             assert_no_sherd_twice(recorded, truth, code)
         except AssertionError as e:
-            raise AssertionError("\n".join(report) + "\n" + str(e) + "\n" + out[-3000:]) from None
+            raise AssertionError(
+                "\n".join(report + [str(e), "killed run:", killed_out[-3000:], "last run:"])
+                + "\n"
+                + out[-3000:]
+            ) from None
     print("\n".join(report))
     print("%d runs in %.0f s" % (KILL_RUNS, time.monotonic() - t_start))
