@@ -238,3 +238,38 @@ TEST(GraspPlanner, ClosesUnderTheLowerEndOfASherdLeaningOnAnother) {
   planner.plan(flat, &context);
   EXPECT_NEAR(flat.grasp.translation().z() - c.gripper.fingertip_offset, 0.6 * 0.008, 1e-9);
 }
+
+TEST(GraspPlanner, ANeighboursCornerUnderAFingerBlocksItAFlyingPixelDoesNot) {
+  // 50 x 40 mm along x at (0.2, 0.25), 8 mm tall: across its minor axis a finger's footprint
+  // reaches 26 to 34 mm off its axis, 10 mm either way along it. A 10 mm tall neighbour's
+  // corner 4 x 4 mm under it (four of the footprint's 55 samples, 2 mm apart) blocks it: the
+  // 90th percentile taken before let it through, and the finger came down on the neighbour.
+  // A 2 x 4 mm speck (two samples: flying pixels at an edge) does not.
+  const GraspPlanner planner(withGripper());
+  const CrowdedView plain;  // its view; its height map is replaced
+  const CameraIntrinsics& k = plain.view.intrinsics;
+  auto corner = [&](double x0, double x1) {
+    cv::Mat h(k.height, k.width, CV_32F, cv::Scalar(0.0f));
+    for (int v = 0; v < k.height; ++v) {
+      for (int u = 0; u < k.width; ++u) {
+        const Eigen::Vector3d p = plain.view.base_T_camera * (0.3 * k.ray(u, v));
+        const double dx = p.x() - 0.2, dy = p.y() - 0.25;
+        if (dx >= x0 && dx <= x1 && dy >= 0.025 && dy <= 0.029) h.at<float>(v, u) = 0.010f;
+      }
+    }
+    return h;
+  };
+  const cv::Mat blocking = corner(0.007, 0.011), speck = corner(0.007, 0.009);
+  GraspContext context = seenFrom(blocking, plain.view);
+  SherdDetection s = sherd(0.2, 0.25, 0.0, 0.050, 0.040, 0.008);
+  planner.plan(s, &context);
+  const bool across =
+      std::fabs(s.grasp.linear().col(1).y()) > 0.999 && std::fabs(s.grasp.translation().x() - 0.2) < 1e-9;
+  EXPECT_FALSE(across && s.finger_clearance >= GraspPlanner::kFingerClearance);  // not taken so
+  context.height = &speck;
+  SherdDetection t = sherd(0.2, 0.25, 0.0, 0.050, 0.040, 0.008);
+  planner.plan(t, &context);
+  EXPECT_TRUE(t.grasp_clear);
+  EXPECT_NEAR(std::fabs(t.grasp.linear().col(1).y()), 1.0, 1e-9);  // across the minor axis
+  EXPECT_NEAR(t.grasp.translation().x(), 0.2, 1e-9);
+}

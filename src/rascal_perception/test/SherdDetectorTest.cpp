@@ -751,3 +751,59 @@ TEST(StackedSherds, ASherdsEndOnAnothersIsSeenCoveringIt) {
   EXPECT_GE(under_covered, 0.9 * pairs);
   EXPECT_GE(top_free, 0.9 * tops);
 }
+
+TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
+  // Heaps tipped out on the mat and settled; every grasp the detector offers as clear is laid on
+  // the simulator's truth: a finger whose footprint (its thickness from the opening outwards,
+  // its width along the grasp) covers at least kTouch of a neighbour's true outline, with that
+  // neighbour's top above the fingertip, comes down on it (heap_25_offcentre seed 73: a
+  // finger beside a sherd called clear pushed its neighbour, and that one another, off the
+  // mat). Printed per case; the neighbour's top is its box's (its highest point: a tilted
+  // neighbour is counted when only its low end is under the finger).
+  constexpr double kTouch = 8e-6;  // [m^2] 8 mm^2 of footprint over the neighbour
+  int offered = 0, on_neighbour = 0;
+  for (unsigned seed = 141; seed <= 150; ++seed) {
+    const rascal_sim::Scenario sc = generatedHeap(seed, 14, 0.025);
+    const Frame f = render(sc, surveyJoints(), 1.5);
+    SherdDetector d(config());
+    const DetectionResult r = calibrateAndDetect(sc, f, d);
+    if (seed <= 142) save("heap_grasps_" + std::to_string(seed), f, r);
+    for (const SherdDetection& s : r.sherds) {
+      if (!s.grasp_clear || s.covered > 0.05) continue;  // what the task layer takes first
+      const Truth* own = nullptr;
+      for (const Truth& t : f.truth) {
+        if (!own || (t.centre - s.centre.head<2>()).norm() < (own->centre - s.centre.head<2>()).norm()) own = &t;
+      }
+      ++offered;
+      const Eigen::Vector2d across = s.grasp.linear().col(1).head<2>().normalized();
+      const Eigen::Vector2d along(across.y(), -across.x());
+      const Eigen::Vector2d c = s.grasp.translation().head<2>();
+      const double tip = s.grasp.translation().z() - config().gripper.fingertip_offset;
+      for (const Truth& t : f.truth) {
+        if (&t == own || t.top <= tip + GraspPlanner::kFingerClearance) continue;
+        std::vector<cv::Point2f> poly;
+        for (const Eigen::Vector2d& p : t.outline) poly.emplace_back(p.x(), p.y());
+        int under = 0;  // 1 mm^2 samples
+        for (const double side : {-1.0, 1.0}) {
+          for (double u = -GraspPlanner::kFingerWidth / 2; u <= GraspPlanner::kFingerWidth / 2; u += 0.001) {
+            for (double v = 0.0; v <= GraspPlanner::kFingerThickness; v += 0.001) {
+              const Eigen::Vector2d p = c + across * side * (s.grasp_width / 2 + v) + along * u;
+              under += cv::pointPolygonTest(poly, cv::Point2f(p.x(), p.y()), false) >= 0;
+            }
+          }
+        }
+        if (under * 1e-6 >= kTouch) {
+          ++on_neighbour;
+          std::printf("seed %u: %s's grasp (clearance %.1f mm) comes down on %s: %d mm^2, its top %.1f mm over the "
+                      "tip\n",
+                      seed, own->name.c_str(), s.finger_clearance * 1e3, t.name.c_str(), under,
+                      (t.top - tip) * 1e3);
+          break;
+        }
+      }
+    }
+  }
+  std::printf("heaps: %d grasps offered clear, %d come down on a neighbour\n", offered, on_neighbour);
+  ASSERT_GE(offered, 30);
+  EXPECT_LE(on_neighbour, 0.05 * offered);
+}

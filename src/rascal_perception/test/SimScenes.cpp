@@ -226,6 +226,21 @@ void makeTouching(Scenario& sc, size_t i, size_t j) {
   for (int k = 0; k < 1000 && gap(a, placed(b)) > 0.0003; ++k) b.pose.head<2>() += 0.0002 * dir;
 }
 
+Scenario generatedHeap(unsigned seed, int count, double spread) {
+  Scenario sc = generated(seed, 1, 1.0, 5600, 0.0);
+  GeneratorOptions g;
+  g.count = count;
+  g.seed = seed;
+  g.area = station(StationType::Pickup).area;
+  g.heap = true;
+  g.heap_centre = g.area.centre;
+  g.heap_spread = spread;
+  g.heap_drop_height = 0.01;
+  sc.name = "heap_" + std::to_string(seed);
+  sc.sherds = ScenarioGenerator(munsell()).generate(g);
+  return sc;
+}
+
 Scenario loadScenario(const std::string& file) {
   return ScenarioLoader(layout(), munsell()).load(std::string(RASCAL_PERCEPTION_SCENARIOS) + "/" + file);
 }

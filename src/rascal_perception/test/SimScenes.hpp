@@ -61,6 +61,9 @@ Frame render(const rascal_sim::Scenario& scenario, const rascal_sim::JointVector
 /// A generated scenario on the pickup mat.
 rascal_sim::Scenario generated(unsigned seed, int count, double brightness, double kelvin, double shadow,
                                int touching_pairs = 0);
+/// A generated heap: `count` sherds tipped out about the pickup mat's centre (spread: standard
+/// deviation of their centres), let go 1 cm over what lies under them, three layers at most.
+rascal_sim::Scenario generatedHeap(unsigned seed, int count, double spread);
 /// Slides sherd j towards sherd i until their outlines touch (within 0.3 mm).
 void makeTouching(rascal_sim::Scenario& scenario, size_t i, size_t j);
 rascal_sim::Scenario loadScenario(const std::string& file);

@@ -190,7 +190,9 @@ double GraspPlanner::fingerClearance(double yaw, double opening, const Eigen::Ve
       }
     }
     if (under.empty()) continue;
-    const size_t k = under.size() * 9 / 10;  // a few noisy pixels do not block a finger
+    // the kBlockingSamples-th highest: a neighbour's corner under that many samples blocks the
+    // finger, fewer (a flying pixel or two at an edge) do not
+    const size_t k = under.size() > kBlockingSamples ? under.size() - kBlockingSamples : 0;
     std::nth_element(under.begin(), under.begin() + k, under.end());
     worst = std::min(worst, tip - under[k]);
   }
