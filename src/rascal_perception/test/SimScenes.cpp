@@ -176,22 +176,40 @@ void Truth::extents(double yaw, double& l, double& w, Eigen::Vector2d& c) const 
   c = 0.5 * (u0 + u1) * a + 0.5 * (v0 + v1) * b;
 }
 
-Scenario generated(unsigned seed, int count, double brightness, double kelvin, double shadow, int touching_pairs) {
+namespace {
+/// `g`'s sherds on the pickup mat under generated lighting; `name` with the seed appended.
+Scenario generatedWith(const std::string& name, unsigned seed, double brightness, double kelvin, double shadow,
+                       GeneratorOptions g) {
   Scenario sc;
-  sc.name = "generated_" + std::to_string(seed);
+  sc.name = name + std::to_string(seed);
   sc.seed = seed;
   sc.lighting.brightness = brightness;
   sc.lighting.colour_temperature = kelvin;
   sc.lighting.shadow_strength = shadow;
   sc.lighting.shadow_radius = 0.07;
   sc.lighting.shadow_start = station(StationType::Pickup).area.centre + Eigen::Vector2d(0.02 * (seed % 5) - 0.04, 0.0);
-  GeneratorOptions g;
-  g.count = count;
   g.seed = seed;
   g.area = station(StationType::Pickup).area;
-  g.touching_pairs = touching_pairs;
   sc.sherds = ScenarioGenerator(munsell()).generate(g);
   return sc;
+}
+}  // namespace
+
+Scenario generated(unsigned seed, int count, double brightness, double kelvin, double shadow, int touching_pairs) {
+  GeneratorOptions g;
+  g.count = count;
+  g.touching_pairs = touching_pairs;
+  return generatedWith("generated_", seed, brightness, kelvin, shadow, g);
+}
+
+Scenario generatedHeap(unsigned seed, int count, double spread) {
+  GeneratorOptions g;
+  g.count = count;
+  g.heap = true;
+  g.heap_centre = station(StationType::Pickup).area.centre;
+  g.heap_spread = spread;
+  g.heap_drop_height = 0.01;
+  return generatedWith("heap_", seed, 1.0, 5600, 0.0, g);
 }
 
 namespace {
@@ -224,21 +242,6 @@ void makeTouching(Scenario& sc, size_t i, size_t j) {
   const Eigen::Vector2d dir = (sc.sherds[i].pose.head<2>() - b.pose.head<2>()).normalized();
   const auto a = placed(sc.sherds[i]);
   for (int k = 0; k < 1000 && gap(a, placed(b)) > 0.0003; ++k) b.pose.head<2>() += 0.0002 * dir;
-}
-
-Scenario generatedHeap(unsigned seed, int count, double spread) {
-  Scenario sc = generated(seed, 1, 1.0, 5600, 0.0);
-  GeneratorOptions g;
-  g.count = count;
-  g.seed = seed;
-  g.area = station(StationType::Pickup).area;
-  g.heap = true;
-  g.heap_centre = g.area.centre;
-  g.heap_spread = spread;
-  g.heap_drop_height = 0.01;
-  sc.name = "heap_" + std::to_string(seed);
-  sc.sherds = ScenarioGenerator(munsell()).generate(g);
-  return sc;
 }
 
 Scenario loadScenario(const std::string& file) {
