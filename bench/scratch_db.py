@@ -6,6 +6,7 @@ import contextlib
 import os
 
 import psycopg2
+import psycopg2.extensions
 import psycopg2.extras
 
 from rascal_tasks.catalogue import scratch
@@ -15,7 +16,17 @@ ADMIN = os.environ.get("RASCAL_TEST_PG_DSN", "postgresql://rascal:rascal@127.0.0
 
 @contextlib.contextmanager
 def scratch_database():
-    """Yields the DSN of a new, empty database; drops it on the way out."""
+    """Yields the DSN of a new, empty database; drops it on the way out. A server not reachable
+    ends the bench with one line that says how to start it."""
+    try:
+        psycopg2.connect(ADMIN, connect_timeout=10).close()
+    except psycopg2.OperationalError as e:
+        where = psycopg2.extensions.parse_dsn(ADMIN)
+        raise SystemExit(
+            "bench: no catalogue server at %s:%s (RASCAL_TEST_PG_DSN): %s; start it with "
+            "`pg_ctlcluster --skip-systemctl-redirect 15 main start` (or run `make test` once)"
+            % (where.get("host", "localhost"), where.get("port", "5432"), str(e).splitlines()[0])
+        ) from None
     with scratch.scratch_database(ADMIN, "rascal_bench_") as dsn:
         yield dsn
 
