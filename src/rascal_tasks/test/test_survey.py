@@ -28,7 +28,7 @@ from rascal_tasks.survey import (
     taken_off_the_mat,
     view_over,
 )
-from rascal_tasks.selection import surely_another
+from rascal_tasks.selection import apart_from_left, surely_another
 
 
 @pytest.fixture
@@ -271,3 +271,18 @@ def test_a_sherd_of_another_colour_does_not_stand_for_one_not_seen_again():
     assert not surely_another(replace(under, covered=0.3), top)
     # itself seen again where it lay, in a neighbour's shadow (darker, of its hue)
     assert not surely_another(replace(top, x=0.285, colour=(0.56, 0.52, 0.44)), top)
+
+
+def test_a_spot_left_for_a_person_stands_for_its_nearest_detection_alone():
+    chip, beside, near_both = _seen(0.20, 0.20), _seen(0.23, 0.20), _seen(0.20, 0.23)
+    far = _seen(0.30, 0.30)
+    # one spot: its nearest goes, the neighbours 3 cm away stay
+    assert apart_from_left([beside, chip, near_both, far], [(0.201, 0.20)]) == [
+        beside,
+        near_both,
+        far,
+    ]
+    # two spots nearest the same detection: one to one, the nearest pair first
+    assert apart_from_left([chip, beside, far], [(0.205, 0.20), (0.21, 0.20)]) == [far]
+    # moved further than LEFT_MOVED: not that sherd
+    assert apart_from_left([far], [(0.20, 0.20)]) == [far]

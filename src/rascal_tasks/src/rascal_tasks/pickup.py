@@ -11,8 +11,8 @@ from rascal_tasks.rig import Observation
 from rascal_tasks.sherd_record import SherdRecord
 from rascal_tasks.singulation import part_from_neighbours
 from rascal_tasks.selection import (
-    SAME_SHERD,
     among_others,
+    apart_from_left,
     covered,
     itself,
     taken_again,
@@ -161,9 +161,8 @@ def look_again(b, o: Observation) -> Optional[Observation]:
     radius = b.config["recovery"]["search_radius"]
     near = [
         c
-        for c in survey_at(b, b.pickup, *look_from(b, o))
+        for c in apart_from_left(survey_at(b, b.pickup, *look_from(b, o)), b.unpickable)
         if c.distance_to(o.x, o.y) < radius
-        and all(c.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)
     ]
     if not near:
         b.log("the sherd seen at (%.3f, %.3f) m is not there now: surveying again" % (o.x, o.y))

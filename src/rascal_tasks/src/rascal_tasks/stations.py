@@ -571,16 +571,26 @@ class ScaleStation(StationPlugin):
     def _wall_doubted(self, sherd, kg: float) -> bool:
         """A sherd not looked at on the pan whose mass `kg` says the wall the pickup measured
         was not one wall (mass_and_size.wall_heavier_than: it lay on something seen as part of
-        it) is looked at now: what it lay on may have come up with it (heap_20 seed 64: 23 g
-        wholly over 27 g, over a third sherd, weighed as one row; an outline and a mass of one).
+        it), or whose wall the pickup did not measure, is looked at now: what it lay on may have
+        come up with it (heap_20 seed 64: 23 g wholly over 27 g, over a third sherd, weighed as
+        one row; an outline and a mass of one).
         True when the look saw two there ("double"). One seen alone gets its wall from the flat
         pan (SherdRecord.measured_alone) instead of none, and is taken up high on its edge
         (manipulation.placed_observation): one lying on it is lifted off it, and the other,
         left on the pan, weighed out of the row by difference (_left_on_pan)."""
-        if sherd.among_others or not wall_heavier_than(sherd.size, kg):
+        if sherd.among_others:
+            return False
+        if wall_heavier_than(sherd.size, kg):
+            why = "its wall doubted"
+        elif sherd.size is not None and sherd.size.thickness <= 0.0:
+            # no wall measured, so no mass bound either: a rider as wide as the one under it
+            # shows one outline with no step (heap_25_offcentre seed 95: 67 x 55 mm, 35.5 g,
+            # two sherds in one row); looked at as if its wall were doubted
+            why = "no wall measured"
+        else:
             return False
         b = self.batch
-        b.log("sherd %d: %.1f g, its wall doubted: the pan looked at" % (sherd.seq, kg * 1000))
+        b.log("sherd %d: %.1f g, %s: the pan looked at" % (sherd.seq, kg * 1000, why))
         sherd.wall_doubted = True
         over = b.next_stays(self.index) is not None
         if over:  # the camera over the scale: the fingers stand round it (measure_here), go up

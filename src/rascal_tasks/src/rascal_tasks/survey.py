@@ -12,6 +12,7 @@ from rascal_tasks.batch import PUSHED_OFF, SLIPPED_AWAY, BatchState, NotSeenAgai
 from rascal_tasks.rig import Leftover, Observation
 from rascal_tasks.selection import (
     SAME_SHERD,
+    apart_from_left,
     SAME_SIZE,
     colour_difference,
     covered,
@@ -400,7 +401,7 @@ def survey_pickup_area(b) -> List[Observation]:
     ]
     account_for_slips(b, found)
     account_for_vanished(b, found)
-    b.seen = [o for o in found if all(o.distance_to(*xy) > 2 * SAME_SHERD for xy in b.unpickable)]
+    b.seen = apart_from_left(found, b.unpickable)
     return list(b.seen)
 
 
