@@ -488,9 +488,10 @@ NOT_SEEN_AGAIN = {
     ),
     PUSHED_OFF: (
         "seen near the mat's edge, not picked up and not seen again (a grasp beside it may "
-        "have pushed it off the mat)",
+        "have pushed it off the mat, or it came up with another sherd)",
         "seen near the mat's edge at (%.3f, %.3f) m, not picked up, not seen again: look "
-        "beside the mat",
+        "beside the mat; if it is not there, it may have come up with a sherd recorded after "
+        "it was seen (that row would then weigh both)",
     ),
 }
 
