@@ -752,15 +752,56 @@ TEST(StackedSherds, ASherdsEndOnAnothersIsSeenCoveringIt) {
   EXPECT_GE(top_free, 0.9 * tops);
 }
 
+namespace {
+/// The truth sherd nearest detection `s` (the one it is of).
+const Truth& truthOf(const Frame& f, const SherdDetection& s) {
+  const Truth* own = &f.truth.front();
+  for (const Truth& t : f.truth) {
+    if ((t.centre - s.centre.head<2>()).norm() < (own->centre - s.centre.head<2>()).norm()) own = &t;
+  }
+  return *own;
+}
+
+/// The neighbour that a finger of `s`'s grasp comes down on, laid on the simulator's truth
+/// (nullptr: none): one whose true outline lies under at least kTouch of a finger's footprint
+/// (its thickness from the opening outwards, its width along the grasp), its top above the
+/// fingertip. The neighbour's top is its box's (its highest point: a tilted neighbour is
+/// counted when only its low end is under the finger). `mm2`, `over`: how much lies under the
+/// finger, how far its top stands over the tip [m].
+const Truth* cameDownOn(const Frame& f, const SherdDetection& s, int& mm2, double& over) {
+  constexpr double kTouch = 8e-6;  // [m^2] 8 mm^2 of footprint over the neighbour
+  const Truth& own = truthOf(f, s);
+  const Eigen::Vector2d across = s.grasp.linear().col(1).head<2>().normalized();
+  const Eigen::Vector2d along(across.y(), -across.x());
+  const Eigen::Vector2d c = s.grasp.translation().head<2>();
+  const double tip = s.grasp.translation().z() - config().gripper.fingertip_offset;
+  for (const Truth& t : f.truth) {
+    if (&t == &own || t.top <= tip + GraspPlanner::kFingerClearance) continue;
+    std::vector<cv::Point2f> poly;
+    for (const Eigen::Vector2d& p : t.outline) poly.emplace_back(p.x(), p.y());
+    int under = 0;  // 1 mm^2 samples
+    for (const double side : {-1.0, 1.0}) {
+      for (double u = -GraspPlanner::kFingerWidth / 2; u <= GraspPlanner::kFingerWidth / 2; u += 0.001) {
+        for (double v = 0.0; v <= GraspPlanner::kFingerThickness; v += 0.001) {
+          const Eigen::Vector2d p = c + across * side * (s.grasp_width / 2 + v) + along * u;
+          under += cv::pointPolygonTest(poly, cv::Point2f(p.x(), p.y()), false) >= 0;
+        }
+      }
+    }
+    if (under * 1e-6 >= kTouch) {
+      mm2 = under;
+      over = t.top - tip;
+      return &t;
+    }
+  }
+  return nullptr;
+}
+}  // namespace
+
 TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
   // Heaps tipped out on the mat and settled; every grasp the detector offers as clear is laid on
-  // the simulator's truth: a finger whose footprint (its thickness from the opening outwards,
-  // its width along the grasp) covers at least kTouch of a neighbour's true outline, with that
-  // neighbour's top above the fingertip, comes down on it (heap_25_offcentre seed 73: a
-  // finger beside a sherd called clear pushed its neighbour, and that one another, off the
-  // mat). Printed per case; the neighbour's top is its box's (its highest point: a tilted
-  // neighbour is counted when only its low end is under the finger).
-  constexpr double kTouch = 8e-6;  // [m^2] 8 mm^2 of footprint over the neighbour
+  // the simulator's truth (cameDownOn; heap_25_offcentre seed 73: a finger beside a sherd
+  // called clear pushed its neighbour, and that one another, off the mat). Printed per case.
   int offered = 0, on_neighbour = 0;
   for (unsigned seed = 141; seed <= 150; ++seed) {
     const rascal_sim::Scenario sc = generatedHeap(seed, 14, 0.025);
@@ -770,36 +811,14 @@ TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
     if (seed <= 142) save("heap_grasps_" + std::to_string(seed), f, r);
     for (const SherdDetection& s : r.sherds) {
       if (!s.grasp_clear || s.covered > 0.05) continue;  // what the task layer takes first
-      const Truth* own = nullptr;
-      for (const Truth& t : f.truth) {
-        if (!own || (t.centre - s.centre.head<2>()).norm() < (own->centre - s.centre.head<2>()).norm()) own = &t;
-      }
       ++offered;
-      const Eigen::Vector2d across = s.grasp.linear().col(1).head<2>().normalized();
-      const Eigen::Vector2d along(across.y(), -across.x());
-      const Eigen::Vector2d c = s.grasp.translation().head<2>();
-      const double tip = s.grasp.translation().z() - config().gripper.fingertip_offset;
-      for (const Truth& t : f.truth) {
-        if (&t == own || t.top <= tip + GraspPlanner::kFingerClearance) continue;
-        std::vector<cv::Point2f> poly;
-        for (const Eigen::Vector2d& p : t.outline) poly.emplace_back(p.x(), p.y());
-        int under = 0;  // 1 mm^2 samples
-        for (const double side : {-1.0, 1.0}) {
-          for (double u = -GraspPlanner::kFingerWidth / 2; u <= GraspPlanner::kFingerWidth / 2; u += 0.001) {
-            for (double v = 0.0; v <= GraspPlanner::kFingerThickness; v += 0.001) {
-              const Eigen::Vector2d p = c + across * side * (s.grasp_width / 2 + v) + along * u;
-              under += cv::pointPolygonTest(poly, cv::Point2f(p.x(), p.y()), false) >= 0;
-            }
-          }
-        }
-        if (under * 1e-6 >= kTouch) {
-          ++on_neighbour;
-          std::printf("seed %u: %s's grasp (clearance %.1f mm) comes down on %s: %d mm^2, its top %.1f mm over the "
-                      "tip\n",
-                      seed, own->name.c_str(), s.finger_clearance * 1e3, t.name.c_str(), under,
-                      (t.top - tip) * 1e3);
-          break;
-        }
+      int mm2 = 0;
+      double over = 0.0;
+      if (const Truth* t = cameDownOn(f, s, mm2, over)) {
+        ++on_neighbour;
+        std::printf("seed %u: %s's grasp (clearance %.1f mm) comes down on %s: %d mm^2, its top %.1f mm over the "
+                    "tip\n",
+                    seed, truthOf(f, s).name.c_str(), s.finger_clearance * 1e3, t->name.c_str(), mm2, over * 1e3);
       }
     }
   }
@@ -807,3 +826,45 @@ TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
   ASSERT_GE(offered, 30);
   EXPECT_LE(on_neighbour, 0.05 * offered);
 }
+
+TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbours) {
+  // As the task layer grasps a sherd of a heap (pickup.look_again): the survey offers it, the
+  // wrist camera looks again from over it, and that view's detection of it is grasped. Those
+  // grasps, offered clear, are laid on the truth as above, on small and big heaps (25 sherds
+  // spread as heap_25_offcentre's); four sherds a heap.
+  int offered = 0, on_neighbour = 0;
+  for (unsigned seed = 141; seed <= 150; ++seed) {
+    const bool big = seed % 2;
+    const rascal_sim::Scenario sc = generatedHeap(seed, big ? 25 : 14, big ? 0.035 : 0.025);
+    const Frame survey = render(sc, surveyJoints(), 1.5);
+    SherdDetector d(config());
+    const DetectionResult first = calibrateAndDetect(sc, survey, d);
+    int looks = 0;
+    for (const SherdDetection& s0 : first.sherds) {
+      if (!s0.grasp_clear || s0.covered > 0.05) continue;
+      if (++looks > 4) break;
+      const Frame f = render(sc, cameraOver(s0.centre.head<2>()), 1.5);
+      const DetectionResult r = d.detect("pickup", f.rgb, f.depth, f.view, pickupZ());
+      const SherdDetection* s = nullptr;
+      for (const SherdDetection& c : r.sherds) {
+        if (!s || (c.centre - s0.centre).head<2>().norm() < (s->centre - s0.centre).head<2>().norm()) s = &c;
+      }
+      ASSERT_NE(s, nullptr) << "seed " << seed << ": nothing seen from over a sherd the survey saw";
+      EXPECT_EQ(truthOf(f, *s).name, truthOf(survey, s0).name) << "seed " << seed << ": another sherd seen nearest";
+      if (!s->grasp_clear || s->covered > 0.05) continue;
+      ++offered;
+      int mm2 = 0;
+      double over = 0.0;
+      if (const Truth* t = cameDownOn(f, *s, mm2, over)) {
+        ++on_neighbour;
+        std::printf("seed %u, seen again: %s's grasp (clearance %.1f mm) comes down on %s: %d mm^2, its top %.1f mm "
+                    "over the tip\n",
+                    seed, truthOf(f, *s).name.c_str(), s->finger_clearance * 1e3, t->name.c_str(), mm2, over * 1e3);
+      }
+    }
+  }
+  std::printf("seen again: %d grasps offered clear, %d come down on a neighbour\n", offered, on_neighbour);
+  ASSERT_GE(offered, 30);
+  EXPECT_LE(on_neighbour, 0.05 * offered);
+}
+

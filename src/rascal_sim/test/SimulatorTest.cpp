@@ -163,6 +163,7 @@ TEST(Simulator, FingersCloseOnASherdAndLiftIt) {
   EXPECT_LT(g.along, 0.1);
   EXPECT_NEAR(g.slip_chance, 0.02, 0.01);
   EXPECT_NE(g.describe().find("grasp of " + truth.name), std::string::npos);
+  EXPECT_TRUE(sim.takeBumps().empty()) << "fingers that close on a sherd and lift it bump nothing";
   // stopping the fingers where they are (a stop, or a command to their position) is no open
   sim.stopGripper();
   sim.commandGripper(sim.fingerPosition());
@@ -187,6 +188,34 @@ TEST(Simulator, FingersClosingAboveASherdAreAMissOnRecord) {
   EXPECT_TRUE(g.left.empty() && g.right.empty());
   EXPECT_LT(g.high, g.ee_z - 0.03);
   EXPECT_NE(g.describe().find("left touched nothing, right nothing"), std::string::npos) << g.describe();
+}
+
+TEST(Simulator, AFingerComingDownOnASherdIsABumpOnRecord) {
+  // the open gripper lowered beside a sherd's centre, one finger over the sherd: the contact is
+  // on record with the finger and the sherd, once however long the finger rests there
+  SimulatorOptions o = quiet();
+  o.initial_joints = pointingDownAt(0.30, 0.20, 0.05);
+  Simulator sim(layout(), o);
+  SherdSpec s = slab("c", 0.30, 0.20, 1850);
+  s.pose.z() = std::atan2(0.20, 0.30);  // the fingers' closing line across its minor axis
+  s.pose.head<2>() += 0.028 * Eigen::Vector2d(-0.20, 0.30).normalized();  // under one finger
+  Scenario sc;
+  sc.sherds = {s};
+  sim.load(sc);
+  for (int i = 0; i < 200; ++i) sim.step();
+  ASSERT_TRUE(sim.takeBumps().empty());
+  TrajectoryPoint p;
+  p.positions = pointingDownAt(0.30, 0.20, 0.006);
+  p.time_from_start = 1.5;
+  sim.commandArm(sim.time(), {p}, {true, true, true, true, true, true});
+  for (int i = 0; i < 2500; ++i) sim.step();
+  const std::vector<Simulator::BumpRecord> bumps = sim.takeBumps();
+  ASSERT_EQ(bumps.size(), 1u);
+  const Simulator::BumpRecord& b = bumps[0];
+  EXPECT_EQ(b.sherd, "c");
+  EXPECT_NE(b.link.find("finger"), std::string::npos) << b.link;
+  EXPECT_LT(b.ee.z(), 0.05);
+  EXPECT_NE(b.describe().find("_finger_link on c at"), std::string::npos) << b.describe();
 }
 
 TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {

@@ -131,6 +131,25 @@ class Simulator {
   };
   const GraspRecord& lastGrasp() const { return last_grasp_; }
 
+  /// The arm coming into contact with a sherd it does not hold while no close is under way (a
+  /// finger coming down on a neighbour, the gripper brushing the heap on its way): for the
+  /// node's log, so that a sherd knocked off the mat is traced to the move that knocked it. A
+  /// contact starts a bump when that sherd was not touched for kBumpGap.
+  struct BumpRecord {
+    double time = 0.0;
+    std::string sherd, link;  ///< the sherd touched; the arm link whose box touched it
+    Eigen::Vector3d ee = Eigen::Vector3d::Zero();      ///< ee_gripper_link [m]
+    Eigen::Vector2d at = Eigen::Vector2d::Zero();      ///< the sherd's centre (x, y) [m]
+    double low = 0.0, high = 0.0;  ///< the sherd's box, lowest and highest z [m]
+    /// "bump at t=124.95 s: left_finger_link on sherd_21 at (0.284, 0.199) m, its box from z
+    /// 12.1 to 25.3 mm; ee_gripper_link at (0.229, 0.218, 0.061) m"
+    std::string describe() const;
+  };
+  static constexpr double kBumpGap = 0.25;  ///< [s]
+  /// The bumps since the last call, oldest first (the last kMaxBumps kept).
+  std::vector<BumpRecord> takeBumps();
+  static constexpr size_t kMaxBumps = 100;
+
   bool injectFault(int fault, double duration, std::string& message);
   std::vector<SherdState> groundTruth() const;
   World& world() { return *world_; }
@@ -175,6 +194,9 @@ class Simulator {
   int close_left_ = -1, close_right_ = -1;  // what each finger touched during this close
   bool close_recorded_ = false;             // this close's grasp or miss is in last_grasp_
   void recordMiss();
+  void recordBumps();
+  std::map<int, double> last_touch_;  // each sherd's last contact with the arm [s]
+  std::vector<BumpRecord> bumps_;
   RenderOutput scratch_;
   std::vector<RenderItem> items_;
 };

@@ -37,6 +37,13 @@ struct FingerContacts {
   double left_depth = 0.0, right_depth = 0.0;
 };
 
+/// An arm box (a finger or a link) in contact with a sherd it does not hold, in the last step.
+struct ArmTouch {
+  int sherd = -1;
+  int link = -1;  ///< ArmLink of the box
+  double depth = 0.0;
+};
+
 class World {
  public:
   /// Static fixtures from layout.boxes (where the stations really stand); the arm starts at the
@@ -63,6 +70,8 @@ class World {
   /// Load on the scale platform [kg] from its support force over the last step.
   double scaleLoad() const;
   const FingerContacts& fingerContacts() const;
+  /// Every arm box touching a sherd it does not hold in the last step, one per (sherd, link).
+  const std::vector<ArmTouch>& armTouches() const;
   /// Fixes sherd i to the gripper (ODE fixed joint) / lets it go.
   void hold(int sherd);
   void release();

@@ -56,6 +56,8 @@ void Simulator::load(const Scenario& scenario) {
   slip_armed_ = false;
   close_armed_ = false;
   open_requested_ = false;
+  last_touch_.clear();
+  bumps_.clear();
 }
 
 void Simulator::moveStations(const std::map<std::string, StationOffset>& offsets) {
@@ -83,6 +85,8 @@ void Simulator::reset() {
   scale_.clearFaults();
   close_armed_ = false;
   open_requested_ = false;
+  last_touch_.clear();
+  bumps_.clear();
 }
 
 void Simulator::commandArm(double start_time, const std::vector<TrajectoryPoint>& points,
@@ -134,6 +138,7 @@ void Simulator::step() {
   gripper_.step(dt, blocked);
   world_->setArmTarget(servos_.positions(), gripper_.position());
   world_->step(dt);
+  recordBumps();
   updateGrasp();
   if (scale_.update(time(), dt, world_->scaleLoad())) scale_fresh_ = true;
   if (archival_.update(time(), world_->armPose())) archival_.deliver(time(), renderArchival(capture_exposure_ev_));
@@ -221,6 +226,56 @@ void Simulator::updateGrasp() {
   slip_lifted_since_ = -1.0;
 }
 
+namespace {
+/// Lowest and highest z of the corners of `s`'s box.
+void boxHeights(const SherdState& s, double& low, double& high) {
+  low = std::numeric_limits<double>::infinity();
+  high = -low;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner(c & 1 ? 0.5 : -0.5, c & 2 ? 0.5 : -0.5, c & 4 ? 0.5 : -0.5);
+    const double z = (s.pose * corner.cwiseProduct(s.box_size)).z();
+    low = std::min(low, z);
+    high = std::max(high, z);
+  }
+}
+}  // namespace
+
+void Simulator::recordBumps() {
+  const bool closing = close_armed_ && gripper_.closing();  // touching what it closes on
+  for (const ArmTouch& t : world_->armTouches()) {
+    const auto last = last_touch_.find(t.sherd);
+    const bool fresh = last == last_touch_.end() || time() - last->second > kBumpGap;
+    last_touch_[t.sherd] = time();
+    if (!fresh || closing) continue;
+    const SherdState s = world_->sherd(static_cast<size_t>(t.sherd));
+    BumpRecord r;
+    r.time = time();
+    r.sherd = s.name;
+    r.link = ArmKinematics::linkName(static_cast<ArmLink>(t.link));
+    r.ee = world_->armPose()[kEeGripperLink].translation();
+    r.at = s.pose.translation().head<2>();
+    boxHeights(s, r.low, r.high);
+    if (bumps_.size() >= kMaxBumps) bumps_.erase(bumps_.begin());
+    bumps_.push_back(r);
+  }
+}
+
+std::vector<Simulator::BumpRecord> Simulator::takeBumps() {
+  std::vector<BumpRecord> out;
+  out.swap(bumps_);
+  return out;
+}
+
+std::string Simulator::BumpRecord::describe() const {
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "bump at t=%.2f s: %s on %s at (%.3f, %.3f) m, its box from z %.1f to %.1f mm; "
+                "ee_gripper_link at (%.3f, %.3f, %.3f) m",
+                time, link.c_str(), sherd.c_str(), at.x(), at.y(), low * 1000.0, high * 1000.0, ee.x(), ee.y(),
+                ee.z());
+  return line;
+}
+
 void Simulator::recordMiss() {
   close_recorded_ = true;
   const Eigen::Vector3d ee = world_->armPose()[kEeGripperLink].translation();
@@ -238,14 +293,7 @@ void Simulator::recordMiss() {
       nearest = d;
       r.sherd = s.name;
       r.off_centre = std::min(1.0, d / std::max(1e-3, 0.5 * s.length));
-      r.low = std::numeric_limits<double>::infinity();
-      r.high = -r.low;
-      for (int c = 0; c < 8; ++c) {  // the box's corners
-        const Eigen::Vector3d corner(c & 1 ? 0.5 : -0.5, c & 2 ? 0.5 : -0.5, c & 4 ? 0.5 : -0.5);
-        const double z = (s.pose * corner.cwiseProduct(s.box_size)).z();
-        r.low = std::min(r.low, z);
-        r.high = std::max(r.high, z);
-      }
+      boxHeights(s, r.low, r.high);
     }
   }
   const auto name = [this](int i) { return i >= 0 ? world_->sherd(static_cast<size_t>(i)).name : std::string(); };

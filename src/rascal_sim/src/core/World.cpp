@@ -107,6 +107,7 @@ struct World::Impl {
   dJointID hold_joint = nullptr;
   int held = -1;
   FingerContacts contacts_now, contacts_last;
+  std::vector<ArmTouch> touches_now, touches_last;
   std::vector<LinkBox> link_boxes;  // the arm's, the fingers with their pads (GripperGeometry::pad)
   Mesh fixtures;
   std::vector<FixtureBox> boxes;  // the layout's collision boxes, where they really stand
@@ -179,6 +180,7 @@ struct World::Impl {
       dJointAttach(j, b1, b2);
       depth = std::max(depth, static_cast<double>(c[i].geom.depth));
     }
+    if (t1->kind == GeomTag::kSherd && arm2) touched(t1->index, t2->index, depth);
     if (t1->kind == GeomTag::kSherd) {
       if (t2->kind == GeomTag::kLeftFinger && depth >= contacts_now.left_depth) {
         contacts_now.left = t1->index;
@@ -188,6 +190,16 @@ struct World::Impl {
         contacts_now.right_depth = depth;
       }
     }
+  }
+
+  void touched(int sherd, int link, double depth) {
+    for (ArmTouch& t : touches_now) {
+      if (t.sherd == sherd && t.link == link) {
+        t.depth = std::max(t.depth, depth);
+        return;
+      }
+    }
+    touches_now.push_back({sherd, link, depth});
   }
 
   void buildFixtures(const WorldLayout& l) {
@@ -372,6 +384,8 @@ void World::clearSherds() {
     dBodyDestroy(s->body);
   }
   w.sherds.clear();
+  w.contacts_last = FingerContacts();
+  w.touches_last.clear();
 }
 
 void World::seedSolver(unsigned long seed) { dRandSetSeed(seed); }
@@ -442,6 +456,7 @@ void World::step(double dt) {
   w.time = time_;
   w.setLinkBodies(true, dt);
   w.contacts_now = FingerContacts();
+  w.touches_now.clear();
   for (auto& s : w.sherds) s->overlap_seen = false;
   dSpaceCollide(w.space, &w, &Impl::nearCallback);
   for (auto& s : w.sherds) s->ignore_overlap = s->ignore_overlap && s->overlap_seen;
@@ -450,6 +465,7 @@ void World::step(double dt) {
   w.setLinkBodies(false, dt);
   w.arm_pose = w.arm_target;
   w.contacts_last = w.contacts_now;
+  std::swap(w.touches_last, w.touches_now);
   w.load = w.platform_feedback.f1[2] / kGravity - kPlatformMass;
   // the pan is fixed to the world: keep numerical drift out of it
   time_ += dt;
@@ -458,6 +474,8 @@ void World::step(double dt) {
 double World::scaleLoad() const { return impl_->load; }
 
 const FingerContacts& World::fingerContacts() const { return impl_->contacts_last; }
+
+const std::vector<ArmTouch>& World::armTouches() const { return impl_->touches_last; }
 
 void World::hold(int sherd) {
   Impl& w = *impl_;

@@ -148,6 +148,10 @@ void SimNode::run() {
         ROS_INFO_STREAM("sim: " << sim_->lastGrasp().describe());
         std::fflush(stdout);  // block-buffered into a file: a bench reads it while this runs
       }
+      for (const Simulator::BumpRecord& b : sim_->takeBumps()) {  // what knocked a sherd, for benches
+        ROS_INFO_STREAM("sim: " << b.describe());
+        std::fflush(stdout);
+      }
       if (sim_->wristFrameDue()) {
         if (cameraWanted()) {
           frame = sim_->renderWristFrame();
