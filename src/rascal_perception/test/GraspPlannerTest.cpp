@@ -168,6 +168,38 @@ TEST(GraspPlanner, MovesTheGraspAlongAnElongatedSherdPastNeighboursBesideItsMidd
   EXPECT_LT(t.grasp.translation().x(), 0.2 - 0.01);
 }
 
+TEST(GraspPlanner, KeepsTheGripperBarOffANeighbourStandingBeyondTheFingers) {
+  // 60 x 36 mm along x at (0.2, 0.25), 8 mm high; a neighbour standing on its edge along one
+  // long side, 40-48 mm off the axis (past the fingers, which reach 32 mm), x within 60 mm. At
+  // 50 mm tall it stands higher than the gripper bar, 32 mm over the fingertips and 100 mm
+  // across the closing direction: no grasp is clear (turned 90 degrees, the bar along it, the
+  // fingers would close on the sherd's ends). At 20 mm the bar passes over it.
+  const GraspPlanner planner(withGripper());
+  ASSERT_FALSE(withGripper().gripper.hand.empty());
+  const CrowdedView crowd;
+  const CameraIntrinsics& k = crowd.view.intrinsics;
+  for (const float tall : {0.050f, 0.020f}) {
+    cv::Mat height = cv::Mat::zeros(crowd.height.size(), CV_32F);
+    for (int v = 0; v < k.height; ++v) {
+      for (int u = 0; u < k.width; ++u) {
+        const Eigen::Vector3d p = crowd.view.base_T_camera * (0.3 * k.ray(u, v));
+        const double dx = std::fabs(p.x() - 0.2), dy = p.y() - 0.25;
+        if (dx <= 0.060 && dy >= 0.040 && dy <= 0.048) height.at<float>(v, u) = tall;
+      }
+    }
+    GraspContext context = seenFrom(height, crowd.view);
+    SherdDetection s = sherd(0.2, 0.25, 0.0, 0.060, 0.036, 0.008);
+    planner.plan(s, &context);
+    EXPECT_EQ(s.grasp_clear, tall < 0.03f) << "neighbour " << tall * 1e3 << " mm tall";
+    if (tall < 0.03f) {
+      EXPECT_NEAR(std::fabs(s.grasp.linear().col(1).y()), 1.0, 1e-9);  // across its width
+    } else {
+      // the grasp to try is the one turned 90 degrees, its bar along the neighbour, not over it
+      EXPECT_NEAR(std::fabs(s.grasp.linear().col(1).x()), 1.0, 1e-9);
+    }
+  }
+}
+
 TEST(GraspPlanner, TurnsASherdTooNarrowToHoldAcrossItsMinorAxis) {
   // 31 mm across: the fingers would stop 1 mm short of shut (30 mm), which the gripper reads as
   // empty; turned 15 degrees they close on a 42 mm chord of the 47 x 31 mm outline

@@ -867,4 +867,3 @@ TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbour
   ASSERT_GE(offered, 30);
   EXPECT_LE(on_neighbour, 0.05 * offered);
 }
-

@@ -99,6 +99,16 @@ class GraspPlanner {
   /// [m] fingertip height above the plane minus what lies under the fingers' footprints.
   double fingerClearance(double yaw, double opening, const Eigen::Vector2d& centre, double surface, double tip,
                          const GraspContext& context) const;
+  /// [m] the least height of the hand above the fingers (the gripper, its bar, the wrist camera:
+  /// config.gripper.hand, from the URDF) over what lies under it, at the grasp and turned by pi
+  /// (the task layer turns the wrist either way: the fingers are alike, the camera is not). In
+  /// heaps a neighbour tilted up or standing on its edge, beyond the fingers' reach, met the bar
+  /// 32 mm over the fingertips or the camera 55 mm over them (heap_25_offcentre seed 95: the
+  /// camera on a sherd standing 82 mm tall, pushed off the mat).
+  double handClearance(double yaw, const Eigen::Vector2d& centre, double surface, double tip,
+                       const GraspContext& context) const;
+  /// [m] samples of the hand's footprints this far apart (its boxes are 20-100 mm)
+  static constexpr double kHandStep = 0.004;
   PerceptionConfig config_;
 };
 

@@ -100,10 +100,13 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
       const double at = tipAtChordEnds(y, hi - lo, c, s.surface, tip, own, *context);
       candidates.push_back({y, open, fingerClearance(y, open, c, s.surface, at, *context), hi - lo, c, at});
     }
-    // the first clear one the fingers can hold; else the clearest they can hold; else the clearest
+    // the first clear one the fingers can hold, the hand above them clear too; else the
+    // clearest they can hold; else the clearest
     const Candidate* pick = nullptr;
-    for (const Candidate& c : candidates) {
+    for (Candidate& c : candidates) {
       if (c.clear >= kFingerClearance && c.chord >= holdableChord()) {
+        c.clear = std::min(c.clear, handClearance(c.yaw, c.centre, s.surface, c.tip, *context));
+        if (c.clear < kFingerClearance) continue;
         pick = &c;
         break;
       }
@@ -195,6 +198,43 @@ double GraspPlanner::fingerClearance(double yaw, double opening, const Eigen::Ve
     const size_t k = under.size() > kBlockingSamples ? under.size() - kBlockingSamples : 0;
     std::nth_element(under.begin(), under.begin() + k, under.end());
     worst = std::min(worst, tip - under[k]);
+  }
+  return worst;
+}
+
+double GraspPlanner::handClearance(double yaw, const Eigen::Vector2d& centre, double surface, double tip,
+                                   const GraspContext& ctx) const {
+  const cv::Mat& height = *ctx.height;
+  // pointing down at yaw: ee x is down, y across (the closing direction), z along
+  const Eigen::Vector2d across(-std::sin(yaw), std::cos(yaw)), along(std::cos(yaw), std::sin(yaw));
+  const Eigen::Isometry3d camera_T_base = ctx.view->base_T_camera.inverse();
+  const double ee = surface + tip + config_.gripper.fingertip_offset;  // ee_gripper_link's z
+  double worst = std::numeric_limits<double>::infinity();
+  for (const rascal_workcell::HandBox& b : config_.gripper.hand) {
+    const double bottom = ee - b.hi[0];
+    for (const double turn : {1.0, -1.0}) {  // the grasp, and the grasp turned by pi
+      std::vector<float> under;
+      for (double v = b.lo[1]; v <= b.hi[1] + 1e-9; v += kHandStep) {
+        for (double w = b.lo[2]; w <= b.hi[2] + 1e-9; w += kHandStep) {
+          const Eigen::Vector2d p = centre + turn * (across * v + along * w);
+          const Eigen::Vector3d q = camera_T_base * Eigen::Vector3d(p.x(), p.y(), bottom);
+          if (q.z() <= 0.0) continue;
+          const Eigen::Vector2d uv = ctx.view->intrinsics.project(q);
+          const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
+          if (x < 0 || y < 0 || x >= height.cols || y >= height.rows) continue;
+          if (ctx.own && ctx.own->bounds.contains(cv::Point(x, y)) &&
+              ctx.own->mask.at<uint8_t>(y - ctx.own->bounds.y, x - ctx.own->bounds.x)) {
+            continue;  // the sherd itself, between the fingers
+          }
+          const float h = height.at<float>(y, x);
+          if (h == h) under.push_back(h);
+        }
+      }
+      if (under.empty()) continue;
+      const size_t k = under.size() > kBlockingSamples ? under.size() - kBlockingSamples : 0;
+      std::nth_element(under.begin(), under.begin() + k, under.end());
+      worst = std::min(worst, bottom - surface - under[k]);
+    }
   }
   return worst;
 }

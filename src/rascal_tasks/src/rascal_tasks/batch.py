@@ -91,6 +91,9 @@ class Batch:
         self.put_back_at = []  # (x, y) of the pickup mat where a put back set sherds down
         self.two_seen = []  # seqs recorded with a second sherd seen on the scale (put back twice)
         self.maybe_two = []  # seqs recorded as one outline whose wall its mass rules out (a note)
+        # (station name, kg, seq weighed with it): a sherd that stayed on a station's pan and
+        # could not be taken to the mat (stations.ScaleStation._left_on_pan), for a person
+        self.left_on_station: List[tuple] = []
         # an unmeasured sherd back among the bag's on the mat: its number goes to the next pick
         self.renumber: Optional[SherdRecord] = None
         self.renumber_unused = ""  # why that row is recorded lost if the mat empties first

@@ -287,6 +287,7 @@ class Run:
                 batch.put_back_at = done[-1].put_back_at
                 batch.two_seen = done[-1].two_seen
                 batch.maybe_two = done[-1].maybe_two
+                batch.left_on_station = done[-1].left_on_station
             progress.batch = batch
             self.batch, self.machine = batch, build_machine(batch)
             if self.stop.is_set():  # Ctrl-C while the machine was being built
@@ -501,8 +502,8 @@ def what_is_left(batch, rows) -> str:
     left on the mat, objects on it perception does not offer as sherds, rows of the context
     lost, without a mass (the scale gave none that could be trusted: mass_unstable, or done with
     mass_missing_reason) or unfinished, rows weighed with a second sherd seen on the scale
-    (stations.LOOK_PUT_BACKS), and rows that may be two lying as one (stations.ScaleStation.
-    _maybe_two)."""
+    (stations.LOOK_PUT_BACKS), rows that may be two lying as one (stations.ScaleStation.
+    _maybe_two), and sherds left on the scale's pan (ScaleStation._left_on_pan)."""
     rows = rows or []
     counts = (
         (len(batch.unpickable), "left on the pickup mat (could not be picked up)"),
@@ -515,6 +516,10 @@ def what_is_left(batch, rows) -> str:
         (sum(r["status"] not in ("done", "lost") for r in rows), "unfinished"),
         (len(batch.two_seen), "recorded with a second sherd seen on the scale (`two_seen`)"),
         (len(batch.maybe_two), "recorded as one that may be two lying as one (`maybe_two`)"),
+        (
+            len(batch.left_on_station),
+            "left on the scale (came up with another, not taken off there: listed above)",
+        ),
     )
     parts = ["%d sherd%s %s" % (n, "" if n == 1 else "s", what) for n, what in counts if n]
     if batch.leftovers:  # perhaps not sherds at all: a chip, a pebble, a label
@@ -548,6 +553,11 @@ def print_summary(batches, rows, outcome, wall_seconds):
     )
     for x, y in batches[-1].unpickable:
         print("left in the pickup area (could not be picked up): sherd at (%.3f, %.3f) m" % (x, y))
+    for station, kg, seq in batches[-1].left_on_station:
+        print(
+            "left on the %s (came up with sherd %s, not taken off there): %.1f g; take it to the "
+            "pickup mat" % (station, seq, kg * 1000)
+        )
     for lo in batches[-1].leftovers:
         print(describe_leftover(lo))
     for u in batches[-1].not_seen_again:

@@ -2,9 +2,17 @@
 // The gripper's limits and finger geometry, read from the URDF (rascal_description) so that no
 // node writes them down again: finger travel from the left_finger joint limits, fingertip position
 // from the finger link's collision box and the ee_gripper_link frame.
+#include <array>
 #include <string>
+#include <vector>
 
 namespace rascal_workcell {
+
+/// A collision box of the hand as axis-aligned bounds [m] in ee_gripper_link's frame (x along
+/// the fingers, towards their tips; y the closing direction, the left finger at +y).
+struct HandBox {
+  std::array<double, 3> lo{}, hi{};
+};
 
 struct GripperGeometry {
   double finger_min = 0.0;  ///< [m] left finger from the centreline, closed (joint lower limit)
@@ -13,6 +21,9 @@ struct GripperGeometry {
   /// [m] pads fitted inside each finger (a site's choice, config arm.gripper.fingertip_pads; 0:
   /// the stock fingers): the opening between the fingers is the joints' gap less two pads.
   double pad = 0.0;
+  /// The collision boxes of the links fixed to ee_gripper_link (the gripper, its bar, the wrist
+  /// camera: what comes down with the fingers above them), the fingers themselves not among them.
+  std::vector<HandBox> hand;
 
   double minOpening() const { return 2.0 * (finger_min - pad); }  ///< [m] between the fingers, closed
   double maxOpening() const { return 2.0 * (finger_max - pad); }  ///< [m] fully open

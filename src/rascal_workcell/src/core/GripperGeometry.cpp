@@ -2,7 +2,11 @@
 
 #include <urdf_parser/urdf_parser.h>
 
+#include <algorithm>
+#include <deque>
 #include <fstream>
+#include <limits>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -13,6 +17,59 @@ namespace {
 constexpr const char* kFingerJoint = "left_finger";
 constexpr const char* kFingerLink = "left_finger_link";
 constexpr const char* kTipJoint = "ee_gripper";  // fingers_link -> ee_gripper_link
+constexpr const char* kTipLink = "ee_gripper_link";
+
+/// p_ee = r * p_link + t
+struct ToEe {
+  urdf::Rotation r;
+  urdf::Vector3 t;
+  urdf::Vector3 operator()(const urdf::Vector3& p) const { return r * p + t; }
+};
+
+urdf::Vector3 plus(const urdf::Vector3& a, const urdf::Vector3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+
+/// The box collisions of every link joined to ee_gripper_link by fixed joints, as bounds in its
+/// frame: walked from it up and down the tree across fixed joints only (the fingers' prismatic
+/// joints and the wrist's revolute one end the walk).
+std::vector<HandBox> handBoxes(const urdf::ModelInterface& model) {
+  std::vector<HandBox> boxes;
+  std::deque<std::pair<urdf::LinkConstSharedPtr, ToEe>> todo{{model.getLink(kTipLink), ToEe{}}};
+  std::set<std::string> seen;
+  while (!todo.empty()) {
+    const auto [link, to] = todo.front();
+    todo.pop_front();
+    if (!link || !seen.insert(link->name).second) continue;
+    for (const urdf::CollisionSharedPtr& c : link->collision_array) {
+      if (!c || !c->geometry || c->geometry->type != urdf::Geometry::BOX) continue;
+      const urdf::Vector3& d = static_cast<const urdf::Box&>(*c->geometry).dim;
+      HandBox b;
+      b.lo.fill(std::numeric_limits<double>::infinity());
+      b.hi.fill(-std::numeric_limits<double>::infinity());
+      for (int k = 0; k < 8; ++k) {
+        const urdf::Vector3 corner(k & 1 ? d.x / 2 : -d.x / 2, k & 2 ? d.y / 2 : -d.y / 2, k & 4 ? d.z / 2 : -d.z / 2);
+        const urdf::Vector3 q = to(plus(c->origin.rotation * corner, c->origin.position));
+        const double v[3] = {q.x, q.y, q.z};
+        for (int i = 0; i < 3; ++i) b.lo[i] = std::min(b.lo[i], v[i]), b.hi[i] = std::max(b.hi[i], v[i]);
+      }
+      boxes.push_back(b);
+    }
+    const auto up = link->parent_joint;
+    if (up && up->type == urdf::Joint::FIXED) {  // the joint inverted: p_link = R^-1 (p_parent - t)
+      const urdf::Pose& j = up->parent_to_joint_origin_transform;
+      const urdf::Rotation inv = j.rotation.GetInverse();
+      ToEe parent{to.r * inv, urdf::Vector3()};
+      const urdf::Vector3 back = parent.r * j.position;
+      parent.t = urdf::Vector3(to.t.x - back.x, to.t.y - back.y, to.t.z - back.z);
+      todo.emplace_back(model.getLink(up->parent_link_name), parent);
+    }
+    for (const urdf::JointSharedPtr& down : link->child_joints) {
+      if (!down || down->type != urdf::Joint::FIXED) continue;
+      const urdf::Pose& j = down->parent_to_joint_origin_transform;
+      todo.emplace_back(model.getLink(down->child_link_name), ToEe{to.r * j.rotation, to(j.position)});
+    }
+  }
+  return boxes;
+}
 }  // namespace
 
 GripperGeometry GripperGeometry::fromUrdf(const std::string& urdf_xml) {
@@ -40,6 +97,7 @@ GripperGeometry GripperGeometry::fromUrdf(const std::string& urdf_xml) {
   const auto& box = static_cast<const urdf::Box&>(*link->collision->geometry);
   const double end = link->collision->origin.position.x + box.dim.x / 2.0;
   g.fingertip_offset = end - tip->parent_to_joint_origin_transform.position.x;
+  g.hand = handBoxes(*model);
   return g;
 }
 
