@@ -211,8 +211,15 @@ def test_a_sherd_still_lying_where_it_lay_does_not_stand_for_one_gone_from_besid
     b.pickup = SimpleNamespace(area=Rect((0.16, 0.25), (0.30, 0.16)))
     b.seen, b.taken_since_survey = [lost, mid], []
     b.said_another = set()
+    lines = []
+    b.log = lines.append
     account_for_vanished(b, [mid])
     assert events == [PUSHED_OFF] and [(u.x, u.y) for u in b.not_seen_again] == [(lost.x, lost.y)]
+    # what was seen there instead is logged with why it does not stand for it (a run traced)
+    assert lines == [
+        "  seen 56 mm from there: 60 x 30 mm at (0.110, 0.255) m, taken for a sherd of the survey "
+        "before still lying there"
+    ], lines
     # still there: nothing said
     b.not_seen_again, b.taken_since_survey = [], []
     events.clear()

@@ -273,16 +273,36 @@ def account_for_vanished(b, found: List[Observation]):
         and not seen_apart(o, found)
     ]
     looked_for = [o for _, _, o in near]
+    kept = still_elsewhere(b.seen, looked_for, found)
+    said = len(b.not_seen_again)
     look_for(
         b,
         PUSHED_OFF,
         near,
-        still_elsewhere(b.seen, looked_for, found),
+        kept,
         lambda c, o: may_stand_for(b, c, o),
         lambda o, radius: "a %.0f x %.0f mm sherd seen at (%.3f, %.3f) m near the mat's edge "
         "was not picked up and is not seen within %.0f mm of there since: a grasp beside it may "
         "have pushed it off the mat" % (o.length * 1000, o.width * 1000, o.x, o.y, radius * 1000),
     )
+    radius = b.config["recovery"]["search_radius"]
+    for u in b.not_seen_again[said:]:  # what was seen there instead, for tracing a run
+        for c in (c for c in found if c.distance_to(u.x, u.y) < radius):
+            b.log(
+                "  seen %.0f mm from there: %.0f x %.0f mm at (%.3f, %.3f) m, %s"
+                % (
+                    c.distance_to(u.x, u.y) * 1000,
+                    c.length * 1000,
+                    c.width * 1000,
+                    c.x,
+                    c.y,
+                    "taken for a sherd of the survey before still lying there"
+                    if all(c is not k for k in kept)
+                    else "not alike"
+                    if not may_stand_for(b, c, u.seen)
+                    else "standing for another",
+                )
+            )
     b.taken_since_survey = []
 
 
