@@ -293,3 +293,29 @@ def test_a_spot_left_for_a_person_stands_for_its_nearest_detection_alone():
     assert apart_from_left([chip, beside, far], [(0.205, 0.20), (0.21, 0.20)]) == [far]
     # moved further than LEFT_MOVED: not that sherd
     assert apart_from_left([far], [(0.20, 0.20)]) == [far]
+
+
+def test_a_much_shorter_neighbour_nudged_beside_it_does_not_stand_for_one_pushed_off():
+    # heap_25_offcentre seed 95: a grasp pushed a 68 x 45 mm sherd 3 cm off the mat's near edge
+    # and nudged a 53 x 36 mm neighbour (near the edge too) 2 cm, to 17 mm from where the first
+    # had lain; that one stood for it: exit 0, said nowhere
+    from rascal_tasks.config import Rect
+
+    gone = replace(_seen(0.2714, 0.1711, 0.068), width=0.045)
+    neighbour = replace(_seen(0.2789, 0.1999, 0.053), width=0.036)
+    nudged = replace(neighbour, x=0.264, y=0.186)
+
+    def survey(found):
+        b, events = _batch()
+        b.pickup = SimpleNamespace(area=Rect((0.16, 0.25), (0.30, 0.16)))
+        b.seen, b.taken_since_survey = [gone, neighbour], []
+        account_for_vanished(b, found)
+        return [(u.x, u.y) for u in b.not_seen_again]
+
+    assert survey([nudged]) == [(gone.x, gone.y)]  # the nudged one is itself
+    # seen again a little shorter (another view's outline): itself
+    assert survey([nudged, replace(gone, x=0.275, length=0.063)]) == []
+    # a quarter shorter: another, unless something lies on it now (it shows less of itself)
+    shorter = replace(gone, x=0.311, length=0.052)  # 4 cm on: not the two of one seen apart
+    assert survey([nudged, shorter]) == [(gone.x, gone.y)]
+    assert survey([nudged, replace(shorter, covered=0.3)]) == []
