@@ -41,6 +41,33 @@ bool bandExtent(const std::vector<Eigen::Vector3d>& outline, const Eigen::Vector
   return hi > lo;
 }
 
+/// The height map's value where base_link point `p` projects, into `under`: none off the image,
+/// on the sherd's own mask (seen there, its top hides what lies past its edge; between the
+/// fingers it is what they close on), or without depth.
+void heightUnder(const GraspContext& ctx, const Eigen::Isometry3d& camera_T_base, const Eigen::Vector3d& p,
+                 std::vector<float>& under) {
+  const Eigen::Vector3d q = camera_T_base * p;
+  if (q.z() <= 0.0) return;
+  const cv::Mat& height = *ctx.height;
+  const Eigen::Vector2d uv = ctx.view->intrinsics.project(q);
+  const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
+  if (x < 0 || y < 0 || x >= height.cols || y >= height.rows) return;
+  if (ctx.own && ctx.own->bounds.contains(cv::Point(x, y)) &&
+      ctx.own->mask.at<uint8_t>(y - ctx.own->bounds.y, x - ctx.own->bounds.x)) {
+    return;
+  }
+  const float h = height.at<float>(y, x);
+  if (h == h) under.push_back(h);
+}
+
+/// The `blocking`-th highest of `under` (reordered): a neighbour's corner under that many
+/// samples blocks what comes down there, fewer (a flying pixel or two at an edge) do not.
+double blockingHeight(std::vector<float>& under, size_t blocking) {
+  const size_t k = under.size() > blocking ? under.size() - blocking : 0;
+  std::nth_element(under.begin(), under.begin() + k, under.end());
+  return under[k];
+}
+
 double outlineGap(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
   double best = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& p : a) {
@@ -169,7 +196,6 @@ double GraspPlanner::tipAtChordEnds(double yaw, double chord, const Eigen::Vecto
 
 double GraspPlanner::fingerClearance(double yaw, double opening, const Eigen::Vector2d& centre, double surface,
                                      double tip, const GraspContext& ctx) const {
-  const cv::Mat& height = *ctx.height;
   const Eigen::Vector2d across(-std::sin(yaw), std::cos(yaw)), along(std::cos(yaw), std::sin(yaw));
   const Eigen::Isometry3d camera_T_base = ctx.view->base_T_camera.inverse();
   double worst = std::numeric_limits<double>::infinity();
@@ -179,32 +205,16 @@ double GraspPlanner::fingerClearance(double yaw, double opening, const Eigen::Ve
     for (double t = 0.0; t <= kFingerThickness + config_.gripper.pad + 1e-9; t += 0.002) {
       for (double u = -kFingerWidth / 2; u <= kFingerWidth / 2 + 1e-9; u += 0.002) {
         const Eigen::Vector2d p = centre + across * side * (opening / 2 + t) + along * u;
-        const Eigen::Vector3d q = camera_T_base * Eigen::Vector3d(p.x(), p.y(), surface + tip);
-        if (q.z() <= 0.0) continue;
-        const Eigen::Vector2d uv = ctx.view->intrinsics.project(q);
-        const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
-        if (x < 0 || y < 0 || x >= height.cols || y >= height.rows) continue;
-        if (ctx.own && ctx.own->bounds.contains(cv::Point(x, y)) &&
-            ctx.own->mask.at<uint8_t>(y - ctx.own->bounds.y, x - ctx.own->bounds.x)) {
-          continue;  // the sherd itself (its top seen past its edge)
-        }
-        const float h = height.at<float>(y, x);
-        if (h == h) under.push_back(h);
+        heightUnder(ctx, camera_T_base, Eigen::Vector3d(p.x(), p.y(), surface + tip), under);
       }
     }
-    if (under.empty()) continue;
-    // the kBlockingSamples-th highest: a neighbour's corner under that many samples blocks the
-    // finger, fewer (a flying pixel or two at an edge) do not
-    const size_t k = under.size() > kBlockingSamples ? under.size() - kBlockingSamples : 0;
-    std::nth_element(under.begin(), under.begin() + k, under.end());
-    worst = std::min(worst, tip - under[k]);
+    if (!under.empty()) worst = std::min(worst, tip - blockingHeight(under, kBlockingSamples));
   }
   return worst;
 }
 
 double GraspPlanner::handClearance(double yaw, const Eigen::Vector2d& centre, double surface, double tip,
                                    const GraspContext& ctx) const {
-  const cv::Mat& height = *ctx.height;
   // pointing down at yaw: ee x is down, y across (the closing direction), z along
   const Eigen::Vector2d across(-std::sin(yaw), std::cos(yaw)), along(std::cos(yaw), std::sin(yaw));
   const Eigen::Isometry3d camera_T_base = ctx.view->base_T_camera.inverse();
@@ -217,23 +227,10 @@ double GraspPlanner::handClearance(double yaw, const Eigen::Vector2d& centre, do
       for (double v = b.lo[1]; v <= b.hi[1] + 1e-9; v += kHandStep) {
         for (double w = b.lo[2]; w <= b.hi[2] + 1e-9; w += kHandStep) {
           const Eigen::Vector2d p = centre + turn * (across * v + along * w);
-          const Eigen::Vector3d q = camera_T_base * Eigen::Vector3d(p.x(), p.y(), bottom);
-          if (q.z() <= 0.0) continue;
-          const Eigen::Vector2d uv = ctx.view->intrinsics.project(q);
-          const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
-          if (x < 0 || y < 0 || x >= height.cols || y >= height.rows) continue;
-          if (ctx.own && ctx.own->bounds.contains(cv::Point(x, y)) &&
-              ctx.own->mask.at<uint8_t>(y - ctx.own->bounds.y, x - ctx.own->bounds.x)) {
-            continue;  // the sherd itself, between the fingers
-          }
-          const float h = height.at<float>(y, x);
-          if (h == h) under.push_back(h);
+          heightUnder(ctx, camera_T_base, Eigen::Vector3d(p.x(), p.y(), bottom), under);
         }
       }
-      if (under.empty()) continue;
-      const size_t k = under.size() > kBlockingSamples ? under.size() - kBlockingSamples : 0;
-      std::nth_element(under.begin(), under.begin() + k, under.end());
-      worst = std::min(worst, bottom - surface - under[k]);
+      if (!under.empty()) worst = std::min(worst, bottom - surface - blockingHeight(under, kBlockingSamples));
     }
   }
   return worst;
