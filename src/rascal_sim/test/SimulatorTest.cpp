@@ -188,6 +188,9 @@ TEST(Simulator, FingersClosingAboveASherdAreAMissOnRecord) {
   EXPECT_TRUE(g.left.empty() && g.right.empty());
   EXPECT_LT(g.high, g.ee_z - 0.03);
   EXPECT_NE(g.describe().find("left touched nothing, right nothing"), std::string::npos) << g.describe();
+  // the node's log gets the miss once
+  EXPECT_EQ(sim.takeLogLines(), std::vector<std::string>{g.describe()});
+  EXPECT_TRUE(sim.takeLogLines().empty());
 }
 
 TEST(Simulator, AFingerComingDownOnASherdIsABumpOnRecord) {

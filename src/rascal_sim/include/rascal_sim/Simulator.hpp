@@ -148,6 +148,9 @@ class Simulator {
   static constexpr double kBumpGap = 0.25;  ///< [s]
   /// The bumps since the last call, oldest first (the last kMaxBumps kept).
   std::vector<BumpRecord> takeBumps();
+  /// The node's log lines since the last call ("grasp of …"/"miss at …" for a close not yet
+  /// given, then the bumps, takeBumps): what a bench traces a run's drops, misses and pushes by.
+  std::vector<std::string> takeLogLines();
   static constexpr size_t kMaxBumps = 100;
 
   bool injectFault(int fault, double duration, std::string& message);
@@ -197,6 +200,7 @@ class Simulator {
   void recordBumps();
   std::map<int, double> last_touch_;  // each sherd's last contact with the arm [s]
   std::vector<BumpRecord> bumps_;
+  int grasps_logged_ = 0;  // last_grasp_.count given by takeLogLines
   RenderOutput scratch_;
   std::vector<RenderItem> items_;
 };

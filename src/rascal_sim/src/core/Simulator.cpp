@@ -266,6 +266,16 @@ std::vector<Simulator::BumpRecord> Simulator::takeBumps() {
   return out;
 }
 
+std::vector<std::string> Simulator::takeLogLines() {
+  std::vector<std::string> lines;
+  if (last_grasp_.count != grasps_logged_) {
+    grasps_logged_ = last_grasp_.count;
+    lines.push_back(last_grasp_.describe());
+  }
+  for (const BumpRecord& b : takeBumps()) lines.push_back(b.describe());
+  return lines;
+}
+
 std::string Simulator::BumpRecord::describe() const {
   char line[256];
   std::snprintf(line, sizeof(line),

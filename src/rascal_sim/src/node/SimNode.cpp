@@ -111,7 +111,6 @@ void SimNode::run() {
     sim0 = sim_->time();
   }
   const auto& names = ArmKinematics::jointNames();
-  int grasps_logged = 0;
   while (ros::ok()) {
     double t = 0.0;
     bool clock = false, joints = false, scale = false, frame_ready = false;
@@ -143,14 +142,9 @@ void SimNode::run() {
         js.velocity.push_back(-sim_->fingerVelocity());
       }
       scale = sim_->takeScaleReading(reading);
-      if (sim_->lastGrasp().count != grasps_logged) {  // each grasp's slip chance, for benches
-        grasps_logged = sim_->lastGrasp().count;
-        ROS_INFO_STREAM("sim: " << sim_->lastGrasp().describe());
+      for (const std::string& line : sim_->takeLogLines()) {  // each close and bump, for benches
+        ROS_INFO_STREAM("sim: " << line);
         std::fflush(stdout);  // block-buffered into a file: a bench reads it while this runs
-      }
-      for (const Simulator::BumpRecord& b : sim_->takeBumps()) {  // what knocked a sherd, for benches
-        ROS_INFO_STREAM("sim: " << b.describe());
-        std::fflush(stdout);
       }
       if (sim_->wristFrameDue()) {
         if (cameraWanted()) {
