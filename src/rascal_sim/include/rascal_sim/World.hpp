@@ -41,7 +41,6 @@ struct FingerContacts {
 struct ArmTouch {
   int sherd = -1;
   int link = -1;  ///< ArmLink of the box
-  double depth = 0.0;
 };
 
 class World {

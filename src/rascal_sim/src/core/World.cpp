@@ -180,7 +180,7 @@ struct World::Impl {
       dJointAttach(j, b1, b2);
       depth = std::max(depth, static_cast<double>(c[i].geom.depth));
     }
-    if (t1->kind == GeomTag::kSherd && arm2) touched(t1->index, t2->index, depth);
+    if (t1->kind == GeomTag::kSherd && arm2) touched(t1->index, t2->index);
     if (t1->kind == GeomTag::kSherd) {
       if (t2->kind == GeomTag::kLeftFinger && depth >= contacts_now.left_depth) {
         contacts_now.left = t1->index;
@@ -192,14 +192,11 @@ struct World::Impl {
     }
   }
 
-  void touched(int sherd, int link, double depth) {
-    for (ArmTouch& t : touches_now) {
-      if (t.sherd == sherd && t.link == link) {
-        t.depth = std::max(t.depth, depth);
-        return;
-      }
+  void touched(int sherd, int link) {
+    for (const ArmTouch& t : touches_now) {
+      if (t.sherd == sherd && t.link == link) return;
     }
-    touches_now.push_back({sherd, link, depth});
+    touches_now.push_back({sherd, link});
   }
 
   void buildFixtures(const WorldLayout& l) {
