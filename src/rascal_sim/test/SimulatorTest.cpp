@@ -219,6 +219,10 @@ TEST(Simulator, AFingerComingDownOnASherdIsABumpOnRecord) {
   EXPECT_NE(b.link.find("finger"), std::string::npos) << b.link;
   EXPECT_LT(b.ee.z(), 0.05);
   EXPECT_NE(b.describe().find("_finger_link on c at"), std::string::npos) << b.describe();
+  // where: a finger's bottom, off the fingers' centre line along the closing direction
+  EXPECT_GT(std::fabs(b.contact.y()), 0.012) << b.describe();
+  EXPECT_LT(b.contact.norm(), 0.05) << b.describe();
+  EXPECT_NE(b.describe().find("mm in its frame"), std::string::npos) << b.describe();
 }
 
 TEST(Simulator, InjectedSlipDropsTheSherdWhichComesToRest) {

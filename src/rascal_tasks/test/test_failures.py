@@ -933,3 +933,26 @@ def test_a_sherd_beside_one_left_for_a_person_is_still_picked(config, capsys):
     assert [s.station for s in world.sherds] == ["pickup", "discard", "discard"]
     said = [ln for ln in capsys.readouterr().out.splitlines() if "batch unpickable" in ln]
     assert len(said) == 1 and "(0.220, 0.250)" in said[0], said
+
+
+def test_a_retry_after_a_miss_takes_no_sherd_lying_under_another(config):
+    # heap_25_offcentre seed 106: a grasp on a tilted sherd closed on nothing, and the retry
+    # took the detection nearest it, a sherd 34 % covered by others, grasped along its length;
+    # the fingers came down on two more and one of them pushed a third off the mat
+    a = Sherd("a", 0.10, 0.22)
+    under = Sherd("under", 0.13, 0.22, covered=0.34)
+    free = Sherd("free", 0.25, 0.30)
+    world = World(config, [a, under, free])
+    world.bad_holds["a"] = 1  # the first close on it holds nothing
+    r = world.rig()
+    detect = r.perception.detect
+    # after the miss it is no longer offered (it slid under a neighbour, or stands on its edge)
+    r.perception.detect = lambda station: [
+        o for o in detect(station) if not (world.closes and abs(o.x - a.x) < 1e-9)
+    ]
+    batch = workflow.Batch(config, r, Recorder(), context="T", log=print)
+    workflow.build_machine(batch).execute()
+    first, second = world.closes[:2]
+    assert first == pytest.approx((0.10, 0.22))
+    # the next close is on a sherd nothing lies on, offered by the survey after the miss
+    assert second == pytest.approx((0.25, 0.30)), world.closes

@@ -141,8 +141,12 @@ class Simulator {
     Eigen::Vector3d ee = Eigen::Vector3d::Zero();      ///< ee_gripper_link [m]
     Eigen::Vector2d at = Eigen::Vector2d::Zero();      ///< the sherd's centre (x, y) [m]
     double low = 0.0, high = 0.0;  ///< the sherd's box, lowest and highest z [m]
+    /// [m] where they touched, in ee_gripper_link's frame (pointing down: x down, y the fingers'
+    /// closing direction): which face of the finger or hand met the sherd
+    Eigen::Vector3d contact = Eigen::Vector3d::Zero();
     /// "bump at t=124.95 s: left_finger_link on sherd_21 at (0.284, 0.199) m, its box from z
-    /// 12.1 to 25.3 mm; ee_gripper_link at (0.229, 0.218, 0.061) m"
+    /// 12.1 to 25.3 mm; ee_gripper_link at (0.229, 0.218, 0.061) m; touching at (-4.0, 27.5,
+    /// 3.1) mm in its frame"
     std::string describe() const;
   };
   static constexpr double kBumpGap = 0.25;  ///< [s]

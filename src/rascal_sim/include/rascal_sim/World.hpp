@@ -41,6 +41,7 @@ struct FingerContacts {
 struct ArmTouch {
   int sherd = -1;
   int link = -1;  ///< ArmLink of the box
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< [m] a contact point in base_link (the first)
 };
 
 class World {

@@ -252,7 +252,9 @@ void Simulator::recordBumps() {
     r.time = time();
     r.sherd = s.name;
     r.link = ArmKinematics::linkName(static_cast<ArmLink>(t.link));
-    r.ee = world_->armPose()[kEeGripperLink].translation();
+    const Eigen::Isometry3d& ee = world_->armPose()[kEeGripperLink];
+    r.ee = ee.translation();
+    r.contact = ee.inverse() * t.point;
     r.at = s.pose.translation().head<2>();
     boxHeights(s, r.low, r.high);
     if (bumps_.size() >= kMaxBumps) bumps_.erase(bumps_.begin());
@@ -277,12 +279,12 @@ std::vector<std::string> Simulator::takeLogLines() {
 }
 
 std::string Simulator::BumpRecord::describe() const {
-  char line[256];
+  char line[320];
   std::snprintf(line, sizeof(line),
                 "bump at t=%.2f s: %s on %s at (%.3f, %.3f) m, its box from z %.1f to %.1f mm; "
-                "ee_gripper_link at (%.3f, %.3f, %.3f) m",
+                "ee_gripper_link at (%.3f, %.3f, %.3f) m; touching at (%.1f, %.1f, %.1f) mm in its frame",
                 time, link.c_str(), sherd.c_str(), at.x(), at.y(), low * 1000.0, high * 1000.0, ee.x(), ee.y(),
-                ee.z());
+                ee.z(), contact.x() * 1000.0, contact.y() * 1000.0, contact.z() * 1000.0);
   return line;
 }
 

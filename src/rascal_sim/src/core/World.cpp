@@ -180,7 +180,9 @@ struct World::Impl {
       dJointAttach(j, b1, b2);
       depth = std::max(depth, static_cast<double>(c[i].geom.depth));
     }
-    if (t1->kind == GeomTag::kSherd && arm2) touched(t1->index, t2->index);
+    if (t1->kind == GeomTag::kSherd && arm2) {
+      touched(t1->index, t2->index, Eigen::Vector3d(c[0].geom.pos[0], c[0].geom.pos[1], c[0].geom.pos[2]));
+    }
     if (t1->kind == GeomTag::kSherd) {
       if (t2->kind == GeomTag::kLeftFinger && depth >= contacts_now.left_depth) {
         contacts_now.left = t1->index;
@@ -192,11 +194,11 @@ struct World::Impl {
     }
   }
 
-  void touched(int sherd, int link) {
+  void touched(int sherd, int link, const Eigen::Vector3d& point) {
     for (const ArmTouch& t : touches_now) {
       if (t.sherd == sherd && t.link == link) return;
     }
-    touches_now.push_back({sherd, link});
+    touches_now.push_back({sherd, link, point});
   }
 
   void buildFixtures(const WorldLayout& l) {
