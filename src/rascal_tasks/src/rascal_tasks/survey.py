@@ -439,6 +439,18 @@ def survey_pickup_area(b) -> List[Observation]:
     account_for_slips(b, found)
     account_for_vanished(b, found)
     b.seen = apart_from_left(found, b.unpickable)
+    # what a later "not seen again" is traced from (bench/heap): size, where, how covered
+    b.log(
+        "survey: %d seen: %s"
+        % (
+            len(b.seen),
+            ", ".join(
+                "%.0fx%.0f mm at (%.3f, %.3f) %.0f%%"
+                % (o.length * 1e3, o.width * 1e3, o.x, o.y, o.covered * 100)
+                for o in b.seen
+            ),
+        )
+    )
     return list(b.seen)
 
 
