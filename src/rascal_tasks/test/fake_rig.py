@@ -59,6 +59,8 @@ class Sherd:
     grasp_turn: float = 0.0
     # the share of its outline perception sees under another sherd (the detection's covered)
     covered: float = 0.0
+    # perception found a grasp of it whose fingers clear its neighbours (the detection's)
+    grasp_clear: bool = True
 
     @property
     def chord(self) -> float:
@@ -367,6 +369,7 @@ class _Perception(rig.Perception):
                 thickness=s.thickness + s.lifted_wall,
                 support=s.support,
                 covered=s.covered,
+                grasp_clear=s.grasp_clear,
             )
             for s in self._in_view(station)
             if self._pickable(s)

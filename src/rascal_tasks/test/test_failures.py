@@ -232,6 +232,49 @@ def test_a_sherd_dropped_again_by_its_turned_grasp_amid_others_is_pushed_apart(c
     assert rec.status() == {1: "done"} and not any("pushed" in line for line in said)
 
 
+def test_a_sherd_first_in_order_with_no_clear_grasp_is_pushed_apart_before_any_grasp(config):
+    """a and c lie uncovered, and no grasp of either clears its neighbours (perception's
+    grasp_clear false: so grasped, a sherd closed along its length slips, or a finger comes
+    down on a neighbour). a, first in the pick order, is pushed apart from c before the
+    fingers close on it, the area surveyed again, and then grasped as it lies (a spot is pushed
+    once); c, alone then, is not pushed. Every sherd recorded once."""
+    world = World(
+        config,
+        [
+            Sherd("a", 0.10, 0.22, grasp_turn=math.pi / 2, grasp_clear=False),
+            Sherd("c", 0.16, 0.22, grasp_turn=math.pi / 2, grasp_clear=False),
+        ],
+    )
+    said = []
+    rec = Recorder()
+    batch = workflow.Batch(config, world.rig(), rec, context="T", log=said.append)
+    assert workflow.build_machine(batch).execute() == "finished"
+    assert rec.status() == {1: "done", 2: "done"}
+    pushes = [line for line in said if line.startswith("batch pushed:")]
+    assert len(pushes) == 1 and "at (0.100, 0.220) m" in pushes[0], said
+    assert "before a grasp: none of its grasps clears them (turned 90 deg" in pushes[0]
+    # pushed before the first grasp, then each grasped once
+    picked = [i for i, line in enumerate(said) if " picked as " in line]
+    assert said.index(pushes[0]) < picked[0], said
+    assert "no grasp clear of its neighbours" in said[picked[0]]
+    assert world.closes_at(0.10, 0.22, within=0.001) == 1
+    assert world.closes_at(0.16, 0.22, within=0.001) == 1
+    assert sum(r.drops for r in rec.sherds.values()) == 0
+    # a clear grasp, or one lying alone: grasped at once
+    for sherds in (
+        [Sherd("a", 0.10, 0.22), Sherd("c", 0.16, 0.22)],
+        [Sherd("a", 0.10, 0.22, grasp_clear=False)],
+    ):
+        said = []
+        rec = Recorder()
+        batch = workflow.Batch(
+            config, World(config, sherds).rig(), rec, context="T", log=said.append
+        )
+        assert workflow.build_machine(batch).execute() == "finished"
+        assert len(rec.status()) == len(sherds)
+        assert not any(line.startswith("batch pushed:") for line in said), said
+
+
 def test_a_sherd_that_slips_out_as_often_twice_over_is_left_for_a_person(config):
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30)])
     world.slips["a"] = (0.11, 0.22)

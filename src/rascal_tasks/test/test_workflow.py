@@ -15,7 +15,7 @@ from rascal_tasks.recovery import Recover
 from rascal_tasks.resume import PUT_BACK_HEIGHT, Calibrate, Home, Resume
 from rascal_tasks.selection import in_pick_order
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.singulation import PUSH, push_direction
+from rascal_tasks.singulation import PUSH, push_direction, pusher_clear
 from rascal_tasks.station_states import AtStation
 from rascal_tasks.config import Rect, config_from_dict, merged
 from rascal_tasks.survey import NextSherd, lawnmower, merge, on_the_mat
@@ -513,6 +513,16 @@ def test_a_push_keeps_the_sherd_on_the_mat_and_moves_it_away_from_its_neighbours
     right = _obs(0.21, 0.25, 0.05, 0.04)
     dx, dy = push_direction(o, [o, left, right], area)
     assert abs(dx) < 0.5 and abs(dy) > 0.85
+    # the closed fingers come down 15 mm outside its outline: not onto a neighbour lying there
+    # (heap_25_offcentre seed 111: a push came down on two, and one went off the mat)
+    below = _obs(0.16, 0.20, 0.05, 0.04)  # where a push along +y starts
+    assert pusher_clear(o, (0.0, 1.0), [left, right])
+    assert not pusher_clear(o, (0.0, 1.0), [left, right, below])
+    d = push_direction(o, [o, left, right, below], area)
+    assert d is None or (pusher_clear(o, d, [left, right, below]) and d[1] < 0.9)
+    # hemmed in on all four sides, no push is tried
+    above = _obs(0.16, 0.30, 0.05, 0.04)
+    assert push_direction(o, [o, left, right, below, above], area) is None
     # in a corner the only pushes left are inwards, and none may end off the mat
     corner = _obs(0.045, 0.205, 0.05, 0.04)
     dx, dy = push_direction(corner, [corner], area)

@@ -3,6 +3,7 @@ gripper, numbered. No ROS in here.
 """
 
 import dataclasses
+import math
 from typing import Optional, Tuple
 
 from rascal_tasks.batch import BatchState
@@ -43,6 +44,8 @@ class Pickup(BatchState):
                 b.pending = []
                 return "missed"
         b.pending_stale = True
+        if self.parted_first(o):
+            return "missed"
         if too_short_to_hold(b, o):
             return self.left_unheld(o)
         slips = len(b.lift_slips)
@@ -59,7 +62,7 @@ class Pickup(BatchState):
             b.sherd.among_others = among_others(o, b.seen + b.leftovers, b.put_back_at)
             b.log(  # what a heap's rows are traced from (bench/heap)
                 "sherd %d picked as %.0f x %.0f mm, top %.1f mm on %.1f mm, wall %.1f mm, %.0f %% "
-                "covered%s"
+                "covered, grasped %.0f deg off its width%s%s"
                 % (
                     b.sherd.seq,
                     o.length * 1000,
@@ -68,6 +71,8 @@ class Pickup(BatchState):
                     o.support * 1000,
                     o.thickness * 1000,
                     o.covered * 100,
+                    abs(math.degrees(o.grasp_turn)),
+                    "" if o.grasp_clear else ", no grasp clear of its neighbours",
                     ", among others" if b.sherd.among_others else "",
                 )
             )
@@ -87,6 +92,32 @@ class Pickup(BatchState):
                 "%d failed grasps" % (o.x, o.y, 2 * attempts),
             )
         return "missed"
+
+    def parted_first(self, o: Observation) -> bool:
+        """No grasp of `o` clears its neighbours (perception's grasp_clear false: every grasp
+        found comes down on one, or closes along its length where one turned so far clears
+        them), and it lies uncovered: first in the pick order, so no sherd lying free has a
+        clear grasp either. It is pushed apart from its neighbours before any grasp
+        (singulation.part_from_neighbours: once a sherd and a spot, within the batch's pushes)
+        and the area surveyed again; one pushed so before is grasped as it is. Grasped so, it
+        slipped (heap runs of session 43: the pickups closing along a sherd's length, at slip
+        chances 0.3-0.6, held most of the drops beyond the two grasps' 0.02 each) or its
+        fingers came down on a neighbour."""
+        b = self.batch
+        others = [c for c in b.pending if not itself(c, o)]
+        if o.grasp_clear or covered(o) or not others:
+            return False
+        if not part_from_neighbours(
+            b,
+            o,
+            others,
+            miss_spot(b, o),
+            "before a grasp: none of its grasps clears them (turned %.0f deg off its width)"
+            % abs(math.degrees(o.grasp_turn)),
+        ):
+            return False
+        b.pending = []
+        return True
 
     def singulate(self, o, others, key) -> bool:
         """Failed twice here: pushed apart from its neighbours (singulation.part_from_neighbours).

@@ -33,6 +33,11 @@ FINGERTIP = urdf_model.fingertip_offset()  # [m] fingertips below ee_gripper_lin
 # [m] ee_gripper_link to the leading finger's outer face, fingers closed and in line with a push
 # (half the closed opening, then the finger's thickness: the URDF's finger box)
 FINGER_REACH = urdf_model.opening_limits()[0] / 2 + urdf_model.finger_thickness()
+FINGER_HALF_WIDTH = urdf_model.finger_width() / 2  # [m] the fingers' half-width along a push
+# [m] the closed fingers come down to push no nearer than this to a neighbour's outline box (the
+# arm's repeatability and the outline's few millimetres: in heaps the fingers met neighbours at
+# the edges of their footprint)
+PUSHER_CLEARANCE = 0.003
 
 
 def push_direction(
@@ -45,7 +50,48 @@ def push_direction(
         (math.cos(2 * math.pi * k / DIRECTIONS), math.sin(2 * math.pi * k / DIRECTIONS))
         for k in range(DIRECTIONS)
     ]
-    return _roomiest(o, directions, PUSH, o.length / 2 + EDGE, others, area)
+    clear = [d for d in directions if pusher_clear(o, d, others)]
+    return _roomiest(o, clear, PUSH, o.length / 2 + EDGE, others, area)
+
+
+def push_start(o: Observation, d: Tuple[float, float]) -> Tuple[float, float]:
+    """Where the closed fingers come down to push `o` along `d`: LEAD outside its outline."""
+    back = o.length / 2 + LEAD
+    return (o.x - back * d[0], o.y - back * d[1])
+
+
+def pusher_clear(o: Observation, d: Tuple[float, float], others: List[Observation]) -> bool:
+    """Whether the closed fingers, come down at push_start to push `o` along `d` (their
+    footprint: FINGER_HALF_WIDTH along `d`, FINGER_REACH across it), lie PUSHER_CLEARANCE clear
+    of every neighbour's outline box (`others`' length x width about their yaw). heap_25_offcentre
+    seed 111: a push before a grasp came down on two neighbours, and one went off the mat."""
+    sx, sy = push_start(o, d)
+    pusher = ((sx, sy), math.atan2(d[1], d[0]), FINGER_HALF_WIDTH, FINGER_REACH)
+    return not any(
+        _boxes_overlap(
+            pusher,
+            ((c.x, c.y), c.yaw, c.length / 2 + PUSHER_CLEARANCE, c.width / 2 + PUSHER_CLEARANCE),
+        )
+        for c in others
+        if c is not o
+    )
+
+
+def _boxes_overlap(a, b) -> bool:
+    """Whether two oriented rectangles ((cx, cy), yaw, half-length, half-width) overlap: no
+    axis of either separates them."""
+
+    def axes(box):
+        (_, yaw, hl, hw) = box
+        return [((math.cos(yaw), math.sin(yaw)), hl), ((-math.sin(yaw), math.cos(yaw)), hw)]
+
+    dx, dy = b[0][0] - a[0][0], b[0][1] - a[0][1]
+    both = axes(a) + axes(b)
+    for n, _ in both:
+        reach = sum(h * abs(n[0] * u[0] + n[1] * u[1]) for u, h in axes(a) + axes(b))
+        if abs(dx * n[0] + dy * n[1]) > reach:
+            return False
+    return True
 
 
 def _roomiest(
@@ -78,8 +124,7 @@ def _roomiest(
 def push(b, o: Observation, d: Tuple[float, float]) -> bool:
     """Push `o` along `d` (see the module). False when the arm refuses a move of it (the
     sherd is then left for a person); other rig errors stop the batch as anywhere."""
-    back = o.length / 2 + LEAD
-    start = (o.x - back * d[0], o.y - back * d[1])
+    start = push_start(o, d)
     end = (o.x + PUSH * d[0], o.y + PUSH * d[1])
     # the fingers close across the push: both touch the sherd
     return _sweep(b, (o.x, o.y), start, end, o.grasp_z, math.atan2(d[1], d[0]))

@@ -134,3 +134,8 @@ def fingertip_offset(urdf_xml: Optional[str] = None) -> float:
 def finger_thickness(urdf_xml: Optional[str] = None) -> float:
     """A finger's thickness along the closing direction, metres (its box's y; 8 mm)."""
     return _finger_box(urdf_xml)[1][1]
+
+
+def finger_width(urdf_xml: Optional[str] = None) -> float:
+    """A finger's width across the closing direction, metres (its box's z; 20 mm)."""
+    return _finger_box(urdf_xml)[1][2]
