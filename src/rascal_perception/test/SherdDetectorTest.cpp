@@ -798,11 +798,25 @@ const Truth* cameDownOn(const Frame& f, const SherdDetection& s, int& mm2, doubl
 }
 }  // namespace
 
+namespace {
+/// Counts in `along` a grasp of `s` closing along its sherd's own long axis (the along term of
+/// the simulator's slip model over 0.1: a grasp that slips), and prints it.
+void alongLength(const Frame& f, const SherdDetection& s, int& along) {
+  const Truth& t = truthOf(f, s);
+  const double a = t.closingAlong(s.grasp.linear().col(1));
+  const double term = 0.6 * a * a * std::min(1.0, 2.5 * t.own_elongation);
+  if (term <= 0.1) return;
+  ++along;
+  std::printf("%s (%.0f x %.0f mm, elongation %.2f) seen %.0f x %.0f mm, grasp closing %.2f along its length\n",
+              t.name.c_str(), t.length * 1e3, t.width * 1e3, t.own_elongation, s.length * 1e3, s.width * 1e3, a);
+}
+}  // namespace
+
 TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
   // Heaps tipped out on the mat and settled; every grasp the detector offers as clear is laid on
   // the simulator's truth (cameDownOn; heap_25_offcentre seed 73: a finger beside a sherd
   // called clear pushed its neighbour, and that one another, off the mat). Printed per case.
-  int offered = 0, on_neighbour = 0;
+  int offered = 0, on_neighbour = 0, along = 0;
   for (unsigned seed = 141; seed <= 150; ++seed) {
     const rascal_sim::Scenario sc = generatedHeap(seed, 14, 0.025);
     const Frame f = render(sc, surveyJoints(), 1.5);
@@ -812,6 +826,7 @@ TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
     for (const SherdDetection& s : r.sherds) {
       if (!s.grasp_clear || s.covered > 0.05) continue;  // what the task layer takes first
       ++offered;
+      alongLength(f, s, along);
       int mm2 = 0;
       double over = 0.0;
       if (const Truth* t = cameDownOn(f, s, mm2, over)) {
@@ -822,7 +837,8 @@ TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
       }
     }
   }
-  std::printf("heaps: %d grasps offered clear, %d come down on a neighbour\n", offered, on_neighbour);
+  std::printf("heaps: %d grasps offered clear, %d come down on a neighbour, %d close along a sherd's own length\n",
+              offered, on_neighbour, along);
   ASSERT_GE(offered, 30);
   EXPECT_LE(on_neighbour, 0.05 * offered);
 }
@@ -832,7 +848,7 @@ TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbour
   // wrist camera looks again from over it, and that view's detection of it is grasped. Those
   // grasps, offered clear, are laid on the truth as above, on small and big heaps (25 sherds
   // spread as heap_25_offcentre's); four sherds a heap.
-  int offered = 0, on_neighbour = 0;
+  int offered = 0, on_neighbour = 0, along = 0;
   for (unsigned seed = 141; seed <= 150; ++seed) {
     const bool big = seed % 2;
     const rascal_sim::Scenario sc = generatedHeap(seed, big ? 25 : 14, big ? 0.035 : 0.025);
@@ -853,6 +869,7 @@ TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbour
       EXPECT_EQ(truthOf(f, *s).name, truthOf(survey, s0).name) << "seed " << seed << ": another sherd seen nearest";
       if (!s->grasp_clear || s->covered > 0.05) continue;
       ++offered;
+      alongLength(f, *s, along);
       int mm2 = 0;
       double over = 0.0;
       if (const Truth* t = cameDownOn(f, *s, mm2, over)) {
@@ -863,7 +880,8 @@ TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbour
       }
     }
   }
-  std::printf("seen again: %d grasps offered clear, %d come down on a neighbour\n", offered, on_neighbour);
+  std::printf("seen again: %d grasps offered clear, %d come down on a neighbour, %d close along a sherd's own length\n",
+              offered, on_neighbour, along);
   ASSERT_GE(offered, 30);
   EXPECT_LE(on_neighbour, 0.05 * offered);
 }

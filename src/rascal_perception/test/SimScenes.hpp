@@ -24,6 +24,15 @@ struct Truth {
   bool convex_up = true;
   std::vector<Eigen::Vector2d> outline;  ///< true outline in base_link (x, y)
   double principal_yaw = 0.0;            ///< major axis of the outline's area moments
+  /// The sherd's own frame in base_link, and its outline's major axis and elongation in it (1 -
+  /// W/L), as the simulator's slip model reads them: a sherd tilted in a heap shows a shorter
+  /// outline from above than its own.
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector2d own_major{1.0, 0.0};
+  double own_elongation = 0.0;
+  /// How far fingers closing along `closing` (base_link, horizontal) close along its own long
+  /// axis, as the simulator's slip model reads it: 0 across, 1 along.
+  double closingAlong(const Eigen::Vector3d& closing) const;
   /// Extents of the true outline along `yaw` and across it, and the centre of that box.
   void extents(double yaw, double& length, double& width, Eigen::Vector2d& centre) const;
 };
