@@ -185,6 +185,22 @@ def test_a_sherd_dropped_from_a_grasp_turned_amid_others_waits_for_them(config):
     assert picked == [pytest.approx(xy) for xy in ((0.25, 0.30), (0.22, 0.20), (0.11, 0.22))]
     assert any("grasp turned 90 deg" in n for n in rec.sherds[2].notes)
     assert batch.unpickable == [] and batch.lost == 0
+    # turned because it is too narrow to hold across (30 mm: the fingers close to 30 mm), not
+    # for its neighbours: neither their going nor a push gives it a grasp across, so it is
+    # grasped again at once, as it was
+    world = World(
+        config,
+        [
+            Sherd("a", 0.10, 0.22, width=0.030, grasp_turn=turned),
+            Sherd("b", 0.25, 0.30),
+            Sherd("c", 0.22, 0.20, grasp_turn=turned),
+        ],
+    )
+    world.slips["a"] = (0.11, 0.22)
+    outcome, batch, rec = _run(config, world)
+    assert outcome == "finished" and rec.status() == {1: "done", 2: "done", 3: "done"}
+    assert rec.sherds[2].pickup_xy == pytest.approx((0.10, 0.22))  # a, after b
+    assert any(n.startswith("recovered: picked up again") for n in rec.sherds[2].notes)
     # not turned: grasped again at once, as before (the slip is its own, not its grasp's)
     world = World(config, [Sherd("a", 0.10, 0.22), Sherd("b", 0.25, 0.30), Sherd("c", 0.22, 0.20)])
     world.slips["a"] = (0.11, 0.22)

@@ -5,7 +5,7 @@ No ROS in here.
 import math
 
 from rascal_tasks.batch import BatchState
-from rascal_tasks.manipulation import grasp_retrying
+from rascal_tasks.manipulation import grasp_retrying, holdable
 from rascal_tasks.pickup import miss_spot
 from rascal_tasks.rig import Observation
 from rascal_tasks.selection import slipped_here, turned
@@ -137,8 +137,13 @@ class Recover(BatchState):
     def _turned_amid(self, s: SherdRecord, station, it: Observation, candidates) -> bool:
         """Whether `s`, not measured yet, lies on the pickup mat again as `it`, whose grasp is
         turned off its minor axis (selection.turned), with other sherds there (nothing else
-        there: nothing will clear its neighbours)."""
+        there: nothing will clear its neighbours), and wide enough to be held across
+        (manipulation.holdable: one narrower is turned because the fingers cannot hold it across,
+        not for its neighbours, and neither their going nor a push gives it a grasp across;
+        heap_22_corner seed 113: a 48 x 30 mm sherd put off, dropped again and pushed)."""
         if station is not self.batch.pickup or s.station_index >= 0 or not turned(it):
+            return False
+        if not holdable(self.batch.config, it.width):
             return False
         return any(c is not it for c in candidates)
 
