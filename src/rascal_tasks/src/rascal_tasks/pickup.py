@@ -115,6 +115,11 @@ class Pickup(BatchState):
             "before a grasp: none of its grasps clears them (turned %.0f deg off its width)"
             % abs(math.degrees(o.grasp_turn)),
         ):
+            b.log(  # for tracing a run: which of part_from_neighbours's rules is in the event
+                "the sherd at (%.3f, %.3f) m has no grasp clear of its neighbours and is not "
+                "pushed (pushed before, no push clear of them that keeps it on the mat, or the "
+                "batch's pushes spent): grasped as it is" % (o.x, o.y)
+            )
             return False
         b.pending = []
         return True
