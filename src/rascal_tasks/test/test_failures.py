@@ -79,6 +79,15 @@ def _run(config, world, recorder=None):
     return outcome, batch, recorder
 
 
+def _finished_saying(config, world):
+    """The batch run to its end ("finished"): its recorder and every line it logged."""
+    said = []
+    rec = Recorder()
+    batch = workflow.Batch(config, world.rig(), rec, context="T", log=said.append)
+    assert workflow.build_machine(batch).execute() == "finished"
+    return rec, said
+
+
 def _near(x, y, radius=0.005, below=None, code="UNREACHABLE"):
     """A refusal of every move within `radius` of (x, y) (and lower than `below`, if given)."""
 
@@ -225,10 +234,7 @@ def test_a_sherd_dropped_again_by_its_turned_grasp_amid_others_is_pushed_apart(c
     )
     world.slips["a"] = (0.11, 0.22)
     world.slips_again["a"] = 1  # twice: then it holds
-    said = []
-    rec = Recorder()
-    batch = workflow.Batch(config, world.rig(), rec, context="T", log=said.append)
-    assert workflow.build_machine(batch).execute() == "finished"
+    rec, said = _finished_saying(config, world)
     assert rec.status() == {1: "done", 2: "done"}
     pushes = [line for line in said if line.startswith("batch pushed:")]
     assert len(pushes) == 1 and "at (0.110, 0.220) m" in pushes[0], said
@@ -241,10 +247,7 @@ def test_a_sherd_dropped_again_by_its_turned_grasp_amid_others_is_pushed_apart(c
     world = World(config, [Sherd("a", 0.10, 0.22, grasp_turn=turned)])
     world.slips["a"] = (0.11, 0.22)
     world.slips_again["a"] = 1
-    said = []
-    rec = Recorder()
-    batch = workflow.Batch(config, world.rig(), rec, context="T", log=said.append)
-    assert workflow.build_machine(batch).execute() == "finished"
+    rec, said = _finished_saying(config, world)
     assert rec.status() == {1: "done"} and not any("pushed" in line for line in said)
 
 
@@ -261,10 +264,7 @@ def test_a_sherd_first_in_order_with_no_clear_grasp_is_pushed_apart_before_any_g
             Sherd("c", 0.16, 0.22, grasp_turn=math.pi / 2, grasp_clear=False),
         ],
     )
-    said = []
-    rec = Recorder()
-    batch = workflow.Batch(config, world.rig(), rec, context="T", log=said.append)
-    assert workflow.build_machine(batch).execute() == "finished"
+    rec, said = _finished_saying(config, world)
     assert rec.status() == {1: "done", 2: "done"}
     pushes = [line for line in said if line.startswith("batch pushed:")]
     assert len(pushes) == 1 and "at (0.100, 0.220) m" in pushes[0], said
@@ -281,12 +281,7 @@ def test_a_sherd_first_in_order_with_no_clear_grasp_is_pushed_apart_before_any_g
         [Sherd("a", 0.10, 0.22), Sherd("c", 0.16, 0.22)],
         [Sherd("a", 0.10, 0.22, grasp_clear=False)],
     ):
-        said = []
-        rec = Recorder()
-        batch = workflow.Batch(
-            config, World(config, sherds).rig(), rec, context="T", log=said.append
-        )
-        assert workflow.build_machine(batch).execute() == "finished"
+        rec, said = _finished_saying(config, World(config, sherds))
         assert len(rec.status()) == len(sherds)
         assert not any(line.startswith("batch pushed:") for line in said), said
 
