@@ -99,10 +99,10 @@ class Pickup(BatchState):
         them), and it lies uncovered: first in the pick order, so no sherd lying free has a
         clear grasp either. It is pushed apart from its neighbours before any grasp
         (singulation.part_from_neighbours: once a sherd and a spot, within the batch's pushes)
-        and the area surveyed again; one pushed so before is grasped as it is. Grasped so, it
-        slipped (heap runs of session 43: the pickups closing along a sherd's length, at slip
-        chances 0.3-0.6, held most of the drops beyond the two grasps' 0.02 each) or its
-        fingers came down on a neighbour."""
+        and the area surveyed again; one pushed so before is grasped as it is. Grasped so, the
+        fingers come down on a neighbour or close along its length, and in heaps those turned
+        pickups (slip chances 0.3-0.6 in the simulator) gave most of the drops to expect beyond
+        the 0.02 of every grasp (docs/heap_runs.md, session 44)."""
         b = self.batch
         others = [c for c in b.pending if not itself(c, o)]
         if o.grasp_clear or covered(o) or not others:
@@ -115,7 +115,7 @@ class Pickup(BatchState):
             "before a grasp: none of its grasps clears them (turned %.0f deg off its width)"
             % abs(math.degrees(o.grasp_turn)),
         ):
-            b.log(  # for tracing a run: which of part_from_neighbours's rules is in the event
+            b.log(  # for tracing a run
                 "the sherd at (%.3f, %.3f) m has no grasp clear of its neighbours and is not "
                 "pushed (pushed before, no push clear of them that keeps it on the mat, or the "
                 "batch's pushes spent): grasped as it is" % (o.x, o.y)

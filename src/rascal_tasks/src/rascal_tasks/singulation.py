@@ -88,7 +88,7 @@ def _boxes_overlap(a, b) -> bool:
     dx, dy = b[0][0] - a[0][0], b[0][1] - a[0][1]
     both = axes(a) + axes(b)
     for n, _ in both:
-        reach = sum(h * abs(n[0] * u[0] + n[1] * u[1]) for u, h in axes(a) + axes(b))
+        reach = sum(h * abs(n[0] * u[0] + n[1] * u[1]) for u, h in both)
         if abs(dx * n[0] + dy * n[1]) > reach:
             return False
     return True
