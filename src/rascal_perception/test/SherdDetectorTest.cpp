@@ -18,6 +18,7 @@
 #include "rascal_perception/SherdDetector.hpp"
 #include "rascal_perception/ShellFit.hpp"
 #include "rascal_sim/SherdMeshBuilder.hpp"
+#include "rascal_sim/SlipModel.hpp"
 
 using namespace rascal_perception;
 using namespace rascal_perception_test;
@@ -804,11 +805,11 @@ namespace {
 void alongLength(const Frame& f, const SherdDetection& s, int& along) {
   const Truth& t = truthOf(f, s);
   const double a = t.closingAlong(s.grasp.linear().col(1));
-  const double term = 0.6 * a * a * std::min(1.0, 2.5 * t.own_elongation);
+  const double term = rascal_sim::SlipModel::alongTerm(a, t.ownElongation());
   if (term <= 0.1) return;
   ++along;
   std::printf("%s (%.0f x %.0f mm, elongation %.2f) seen %.0f x %.0f mm, grasp closing %.2f along its length\n",
-              t.name.c_str(), t.length * 1e3, t.width * 1e3, t.own_elongation, s.length * 1e3, s.width * 1e3, a);
+              t.name.c_str(), t.length * 1e3, t.width * 1e3, t.ownElongation(), s.length * 1e3, s.width * 1e3, a);
 }
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include "rascal_sim/ScenarioLoader.hpp"
 #include "rascal_sim/SherdMeshBuilder.hpp"
 #include "rascal_sim/Simulator.hpp"
+#include "rascal_sim/SlipModel.hpp"
 
 using namespace rascal_sim;
 
@@ -162,17 +163,16 @@ Frame render(const Scenario& scenario, const JointVector& q, double settle_s) {
       t.principal_yaw = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
     }
     t.rotation = s.pose.linear();
-    const rascal_sim::OutlineAxes axes = rascal_sim::SherdMeshBuilder::principalAxes(s.outline);
-    t.own_major = axes.major;
-    t.own_elongation = axes.length > 0 ? 1.0 - axes.width / axes.length : 0.0;
+    t.own_axes = rascal_sim::SherdMeshBuilder::principalAxes(s.outline);
     f.truth.push_back(t);
   }
   return f;
 }
 
+double Truth::ownElongation() const { return rascal_sim::SlipModel::elongation(own_axes); }
+
 double Truth::closingAlong(const Eigen::Vector3d& closing) const {
-  const Eigen::Vector3d a = rotation.transpose() * closing;
-  return std::abs(a.head<2>().dot(own_major)) / std::max(1e-9, a.head<2>().norm());
+  return rascal_sim::SlipModel::closingAlong(rotation.transpose() * closing, own_axes);
 }
 
 void Truth::extents(double yaw, double& l, double& w, Eigen::Vector2d& c) const {

@@ -9,6 +9,7 @@
 #include "rascal_perception/SherdMeasurer.hpp"
 #include "rascal_sim/ArmKinematics.hpp"
 #include "rascal_sim/Scenario.hpp"
+#include "rascal_sim/SherdMeshBuilder.hpp"
 #include "rascal_sim/SimParameters.hpp"
 #include "rascal_sim/WorldLayout.hpp"
 
@@ -24,12 +25,12 @@ struct Truth {
   bool convex_up = true;
   std::vector<Eigen::Vector2d> outline;  ///< true outline in base_link (x, y)
   double principal_yaw = 0.0;            ///< major axis of the outline's area moments
-  /// The sherd's own frame in base_link, and its outline's major axis and elongation in it (1 -
-  /// W/L), as the simulator's slip model reads them: a sherd tilted in a heap shows a shorter
+  /// The sherd's own frame in base_link, and its outline's own axes in it, as the simulator's
+  /// slip model (rascal_sim::SlipModel) reads them: a sherd tilted in a heap shows a shorter
   /// outline from above than its own.
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector2d own_major{1.0, 0.0};
-  double own_elongation = 0.0;
+  rascal_sim::OutlineAxes own_axes;
+  double ownElongation() const;
   /// How far fingers closing along `closing` (base_link, horizontal) close along its own long
   /// axis, as the simulator's slip model reads it: 0 across, 1 along.
   double closingAlong(const Eigen::Vector3d& closing) const;

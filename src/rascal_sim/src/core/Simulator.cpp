@@ -8,6 +8,7 @@
 #include <string>
 
 #include "rascal_sim/SherdMeshBuilder.hpp"
+#include "rascal_sim/SlipModel.hpp"
 
 namespace rascal_sim {
 
@@ -191,24 +192,16 @@ void Simulator::updateGrasp() {
   world_->hold(i);
   const SherdState s = world_->sherd(i);
   grasp_z_ = s.pose.translation().z();
-  // Slip model (a simulator choice, not a measured figure): off-centre grasps, fingers closing
-  // along the long axis and payloads above the 0.25 kg working payload slip more often.
+  // off-centre grasps, fingers closing along the long axis and payloads above the 0.25 kg
+  // working payload slip more often (SlipModel: a simulator choice, not a measured figure)
   const auto& arm = world_->armPose();
   const Eigen::Vector3d c = s.pose.inverse() * arm[kEeGripperLink].translation();
   const double off = std::min(1.0, std::hypot(c.x(), c.y()) / std::max(1e-3, 0.5 * s.length));
   // along the outline's own major axis, as a person (and the detector) sees it
   const OutlineAxes axes = SherdMeshBuilder::principalAxes(s.outline);
-  const Eigen::Vector3d a = s.pose.linear().transpose() * arm[kFingersLink].linear().col(1);
-  const double along = std::abs(a.head<2>().dot(axes.major)) / std::max(1e-9, a.head<2>().norm());
-  const double elongation = axes.length > 0 ? 1.0 - axes.width / axes.length : 0.0;
-  // A sherd as wide as it is long has no long axis to close along (turned 90° it is the same
-  // grasp), so that term grows with the elongation, in full from W/L = 0.6. (An outline wider
-  // across its principal axis than along it makes the term negative, a chance below 0.02.
-  // Clamping it at 0 was tried in session 26: it changed the draws of the end-to-end tests'
-  // scenario and their reruns met a wrist camera TF 9 s stale; left as it was.)
-  double p = 0.02 + 0.5 * off * off + 0.6 * along * along * std::min(1.0, 2.5 * elongation);
-  if (s.mass > kMaxPayload) p += 0.9;
-  p = std::min(0.98, p);
+  const double along = SlipModel::closingAlong(s.pose.linear().transpose() * arm[kFingersLink].linear().col(1), axes);
+  const double elongation = SlipModel::elongation(axes);
+  const double p = SlipModel::chance(off, along, elongation, s.mass > kMaxPayload);
   GraspRecord r;
   r.count = last_grasp_.count + 1;
   r.sherd = s.name;
