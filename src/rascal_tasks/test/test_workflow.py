@@ -15,7 +15,7 @@ from rascal_tasks.recovery import Recover
 from rascal_tasks.resume import PUT_BACK_HEIGHT, Calibrate, Home, Resume
 from rascal_tasks.selection import in_pick_order
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.singulation import PUSH, push_direction, pusher_clear
+from rascal_tasks.singulation import PUSH, path_clear, push_direction, pusher_clear
 from rascal_tasks.station_states import AtStation
 from rascal_tasks.config import Rect, config_from_dict, merged
 from rascal_tasks.survey import NextSherd, lawnmower, merge, on_the_mat
@@ -520,6 +520,18 @@ def test_a_push_keeps_the_sherd_on_the_mat_and_moves_it_away_from_its_neighbours
     assert not pusher_clear(o, (0.0, 1.0), [left, right, below])
     d = push_direction(o, [o, left, right, below], area)
     assert d is None or (pusher_clear(o, d, [left, right, below]) and d[1] < 0.9)
+    # nor does it drive the sherd into one lying ahead (heap_20 seed 116: a push drove one into
+    # a stack of two near the mat's edge, which slid half off it)
+    ahead = _obs(0.16, 0.315, 0.02, 0.016)  # beyond its leading edge, clear of the fingers
+    assert pusher_clear(o, (0.0, 1.0), [left, right, ahead])
+    assert not path_clear(o, (0.0, 1.0), [left, right, ahead])
+    assert path_clear(o, (0.0, -1.0), [left, right, ahead])
+    dx, dy = push_direction(o, [o, left, right, ahead], area)
+    assert dy < -0.85
+    # what it lies on is slid off, not shoved: not in the way
+    bed = dataclasses.replace(_obs(0.16, 0.27, 0.05, 0.06), height=0.008)
+    lying = dataclasses.replace(o, support=0.008, height=0.018)
+    assert path_clear(lying, (0.0, 1.0), [bed]) and not path_clear(o, (0.0, 1.0), [bed])
     # hemmed in on all four sides, no push is tried
     above = _obs(0.16, 0.30, 0.05, 0.04)
     assert push_direction(o, [o, left, right, below, above], area) is None

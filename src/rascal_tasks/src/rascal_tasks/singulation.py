@@ -20,7 +20,7 @@ from rascal_workcell import urdf_model
 
 from rascal_tasks.failures import about_this_sherd
 from rascal_tasks.rig import Leftover, Observation, RigError
-from rascal_tasks.selection import same_size
+from rascal_tasks.selection import STACKED, same_size
 
 PUSH = 0.04  # [m] how far the sherd's centre is pushed: most of a neighbour's width
 LEAD = 0.015  # [m] the fingers start this far outside its outline
@@ -38,6 +38,9 @@ FINGER_HALF_WIDTH = urdf_model.finger_width() / 2  # [m] the fingers' half-width
 # arm's repeatability and the outline's few millimetres: in heaps the fingers met neighbours at
 # the edges of their footprint)
 PUSHER_CLEARANCE = 0.003
+# [m] a neighbour whose outline box reaches this little into the strip a pushed sherd sweeps is
+# slid past, not shoved (sherds touching side by side in a heap)
+SLID_PAST = 0.001
 
 
 def push_direction(
@@ -50,7 +53,7 @@ def push_direction(
         (math.cos(2 * math.pi * k / DIRECTIONS), math.sin(2 * math.pi * k / DIRECTIONS))
         for k in range(DIRECTIONS)
     ]
-    clear = [d for d in directions if pusher_clear(o, d, others)]
+    clear = [d for d in directions if pusher_clear(o, d, others) and path_clear(o, d, others)]
     return _roomiest(o, clear, PUSH, o.length / 2 + EDGE, others, area)
 
 
@@ -67,14 +70,36 @@ def pusher_clear(o: Observation, d: Tuple[float, float], others: List[Observatio
     seed 111: a push before a grasp came down on two neighbours, and one went off the mat."""
     sx, sy = push_start(o, d)
     pusher = ((sx, sy), math.atan2(d[1], d[0]), FINGER_HALF_WIDTH, FINGER_REACH)
+    return not any(_boxes_overlap(pusher, _box(c, PUSHER_CLEARANCE)) for c in others if c is not o)
+
+
+def path_clear(o: Observation, d: Tuple[float, float], others: List[Observation]) -> bool:
+    """Whether `o`, pushed PUSH along `d`, sweeps into no neighbour: the strip its outline box
+    covers ahead of it (from its leading edge PUSH on, as wide across `d` as the box, less
+    SLID_PAST each side) meets no neighbour's outline box but those it lies on (their tops no
+    higher than what it rests on: it is pushed at its own mid-height and slides off them).
+    heap_20 seed 116: a push drove a sherd into a stack of two lying near the mat's edge; they
+    slid 25 mm, half off the mat, and a grasp beside them later pushed the top one off it, said
+    nowhere."""
+    theta = math.atan2(d[1], d[0])
+    rel = o.yaw - theta
+    ahead = abs(o.length / 2 * math.cos(rel)) + abs(o.width / 2 * math.sin(rel))
+    across = abs(o.length / 2 * math.sin(rel)) + abs(o.width / 2 * math.cos(rel))
+    mid = ahead + PUSH / 2
+    strip = ((o.x + mid * d[0], o.y + mid * d[1]), theta, PUSH / 2, across - SLID_PAST)
+    own = _box(o, 0.0)
     return not any(
-        _boxes_overlap(
-            pusher,
-            ((c.x, c.y), c.yaw, c.length / 2 + PUSHER_CLEARANCE, c.width / 2 + PUSHER_CLEARANCE),
-        )
+        _boxes_overlap(strip, _box(c, 0.0))
         for c in others
         if c is not o
+        and not (c.height <= o.support + STACKED and _boxes_overlap(own, _box(c, 0.0)))
     )
+
+
+def _box(c, grown: float):
+    """The outline box of `c` (an Observation) grown by `grown` all round, as _boxes_overlap
+    reads it."""
+    return ((c.x, c.y), c.yaw, c.length / 2 + grown, c.width / 2 + grown)
 
 
 def _boxes_overlap(a, b) -> bool:
