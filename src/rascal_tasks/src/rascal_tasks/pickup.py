@@ -117,8 +117,8 @@ class Pickup(BatchState):
         ):
             b.log(  # for tracing a run
                 "the sherd at (%.3f, %.3f) m has no grasp clear of its neighbours and is not "
-                "pushed (pushed before, no push clear of them that keeps it on the mat, or the "
-                "batch's pushes spent): grasped as it is" % (o.x, o.y)
+                "pushed (pushed before; no push whose fingers and path are clear of them and that "
+                "keeps it on the mat; or the batch's pushes spent): grasped as it is" % (o.x, o.y)
             )
             return False
         b.pending = []
