@@ -18,6 +18,7 @@ from rascal_tasks.run_batch import what_is_left
 from rascal_tasks.survey import (
     LOOK_BACK,
     account_for_vanished,
+    came_up_with,
     MAX_EXTRA_LOOKS,
     describe_leftover,
     lawnmower,
@@ -344,3 +345,30 @@ def test_a_sherd_taken_off_the_mat_since_does_not_claim_what_is_seen_where_it_la
     assert survey([replace(whole, length=0.066, x=0.125, y=0.206)], []) == [
         (half_seen.x, half_seen.y)
     ]
+
+
+def test_sherds_that_came_up_with_the_one_picked_are_not_looked_for_where_they_lay():
+    # heap_20 seed 116: three sherds stacked near the mat's edge (two seen, the top one not)
+    # came up in one grasp, the wrist camera saw three on the pan, and they were put back apart
+    # mid-mat; the one seen beside the picked one was looked for where it lay and said not seen
+    # again (exit 1, a false alarm)
+    from rascal_tasks.config import Rect
+
+    picked = replace(_seen(0.104, 0.183, 0.038), width=0.033)
+    beside = replace(_seen(0.122, 0.198, 0.041), width=0.028)
+    apart = _seen(0.25, 0.18, 0.040)  # near the edge too, not reaching the picked one
+    put_back = [_seen(0.202, 0.255), _seen(0.076, 0.265)]
+
+    def survey(extra):
+        b, events = _batch()
+        b.pickup = SimpleNamespace(area=Rect((0.16, 0.25), (0.30, 0.16)))
+        b.seen, b.taken_since_survey = [picked, beside, apart], [(picked.x, picked.y)]
+        came_up_with(b, SimpleNamespace(picked_xy=(picked.x, picked.y), size=picked), extra)
+        account_for_vanished(b, put_back)
+        return [(u.x, u.y) for u in b.not_seen_again]
+
+    # one came up with it: the sherd beside it is accounted for, the one apart still looked for
+    assert survey(2) == [(apart.x, apart.y)]
+    assert survey(1) == [(apart.x, apart.y)]
+    # none came up with it: both are looked for
+    assert survey(0) == [(beside.x, beside.y), (apart.x, apart.y)]

@@ -517,6 +517,9 @@ class ScaleStation(StationPlugin):
         if two and times < LOOK_PUT_BACKS:
             b.put_back_doubles[sherd.seq] = times + 1
             b.event(sherd, "two_in_one", two)
+            from rascal_tasks.survey import came_up_with  # survey imports batch, which imports this
+
+            came_up_with(b, sherd, len(seen) - 1)
             return "double"
         if two:  # two outlines are no heavy sherd: recorded as weighed, and a person must look
             b.two_seen.append(sherd.seq)
@@ -572,6 +575,9 @@ class ScaleStation(StationPlugin):
             # (station_states.PutBack) and the sherd keeps its number for the next pick
             b.put_back_doubles[sherd.seq] = 1
             b.event(sherd, "two_in_one", too_heavy)
+            from rascal_tasks.survey import came_up_with
+
+            came_up_with(b, sherd, 1)
             return "double"
         if not too_heavy and self._wall_doubted(sherd, reading.mass):
             return "double"

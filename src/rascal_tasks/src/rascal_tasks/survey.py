@@ -206,6 +206,28 @@ def taken_off_the_mat(b, grasped: Observation, surveyed: Optional[Observation] =
         b.taken_since_survey.append((it.x, it.y))
 
 
+def came_up_with(b, sherd, extra: int):
+    """Note for the edge check (account_for_vanished) that `extra` sherds of the last survey
+    (`b.seen`) came up with `sherd` (a SherdRecord) in one grasp, seen on the pan beside it or
+    weighed heavier than it can be: the ones nearest where it was picked whose outlines reached
+    it, not taken already. They are put back elsewhere on the mat (station_states.PutBack), and
+    looked for where they lay they were said pushed off it (heap_20 seed 116: three sherds
+    stacked near the mat's edge came up in one grasp and were put back apart; one was said not
+    seen again, exit 1, a false alarm)."""
+    x, y = sherd.picked_xy
+    length = sherd.size.length
+    near = sorted(
+        (
+            c
+            for c in b.seen
+            if c.distance_to(x, y) < (length + c.length) / 2
+            and all(math.hypot(c.x - tx, c.y - ty) > SAME_SHERD for tx, ty in b.taken_since_survey)
+        ),
+        key=lambda c: c.distance_to(x, y),
+    )
+    b.taken_since_survey.extend((c.x, c.y) for c in near[:extra])
+
+
 def seen_apart(o: Observation, found: List[Observation]) -> bool:
     """Whether `o`, of an earlier survey, was several of a heap's sherds seen as one that this
     survey (`found`) sees apart: longer than any sherd it sees, and two or more sherds lie
