@@ -213,7 +213,10 @@ def came_up_with(b, sherd, extra: int):
     it, not taken already. They are put back elsewhere on the mat (station_states.PutBack), and
     looked for where they lay they were said pushed off it (heap_20 seed 116: three sherds
     stacked near the mat's edge came up in one grasp and were put back apart; one was said not
-    seen again, exit 1, a false alarm)."""
+    seen again, exit 1, a false alarm). A sherd not picked by this run (found on a station
+    after a restart) has no spot to be near."""
+    if sherd.picked_xy is None or sherd.size is None:
+        return
     x, y = sherd.picked_xy
     length = sherd.size.length
     near = sorted(
