@@ -100,6 +100,8 @@ class Batch:
         self.seen: List[Observation] = []  # the last survey of the pickup area, merged
         # (x, y) where sherds were taken off the pickup mat since that survey
         self.taken_since_survey: List[tuple] = []
+        # ((x, y) a push sent it to, its Observation) for the pushes since that survey
+        self.pushed_since_survey: List[tuple] = []
         # sherds that slipped while lifted, or lay near the mat's edge, and were not seen again
         self.not_seen_again: List[NotSeenAgain] = []
         # (id, id) of the sherds told apart by colour and logged so (each pair said once)

@@ -164,7 +164,9 @@ def part_from_neighbours(b, o: Observation, others: List[Observation], key, afte
     d = push_direction(o, others, b.pickup.area)
     if d is None or not push(b, o, d):
         return False
-    b.pushed_to.append(((o.x + PUSH * d[0], o.y + PUSH * d[1]), o))
+    sent = ((o.x + PUSH * d[0], o.y + PUSH * d[1]), o)
+    b.pushed_to.append(sent)
+    b.pushed_since_survey.append(sent)  # looked for there by the next survey's edge check
     b.event(
         None,
         "pushed",
