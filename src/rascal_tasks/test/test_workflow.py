@@ -521,7 +521,7 @@ def test_a_push_keeps_the_sherd_on_the_mat_and_moves_it_away_from_its_neighbours
     d = push_direction(o, [o, left, right, below], area)
     assert d is None or (pusher_clear(o, d, [left, right, below]) and d[1] < 0.9)
     # nor does it drive the sherd into one lying ahead (heap_20 seed 116: a push drove one into
-    # a stack of two near the mat's edge, which slid half off it)
+    # a stack of three near the mat's edge, which slid half off it)
     ahead = _obs(0.16, 0.315, 0.02, 0.016)  # beyond its leading edge, clear of the fingers
     assert pusher_clear(o, (0.0, 1.0), [left, right, ahead])
     assert not path_clear(o, (0.0, 1.0), [left, right, ahead])

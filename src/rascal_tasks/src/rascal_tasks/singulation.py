@@ -78,7 +78,7 @@ def path_clear(o: Observation, d: Tuple[float, float], others: List[Observation]
     covers ahead of it (from its leading edge PUSH on, as wide across `d` as the box, less
     SLID_PAST each side) meets no neighbour's outline box but those it lies on (their tops no
     higher than what it rests on: it is pushed at its own mid-height and slides off them).
-    heap_20 seed 116: a push drove a sherd into a stack of two lying near the mat's edge; they
+    heap_20 seed 116: a push drove a sherd into a stack of three lying near the mat's edge; they
     slid 25 mm, half off the mat, and a grasp beside them later pushed the top one off it, said
     nowhere."""
     theta = math.atan2(d[1], d[0])
