@@ -206,6 +206,12 @@ def taken_off_the_mat(b, grasped: Observation, surveyed: Optional[Observation] =
         b.taken_since_survey.append((it.x, it.y))
 
 
+def taken_since(b, o: Observation) -> bool:
+    """Whether `o`, of the last survey, was noted taken off the mat since (within SAME_SHERD of
+    a spot of `b.taken_since_survey`)."""
+    return any(math.hypot(o.x - x, o.y - y) <= SAME_SHERD for x, y in b.taken_since_survey)
+
+
 def came_up_with(b, sherd, extra: int):
     """Note for the edge check (account_for_vanished) that `extra` sherds of the last survey
     (`b.seen`) came up with `sherd` (a SherdRecord) in one grasp, seen on the pan beside it or
@@ -223,8 +229,7 @@ def came_up_with(b, sherd, extra: int):
         (
             c
             for c in b.seen
-            if c.distance_to(x, y) < (length + c.length) / 2
-            and all(math.hypot(c.x - tx, c.y - ty) > SAME_SHERD for tx, ty in b.taken_since_survey)
+            if c.distance_to(x, y) < (length + c.length) / 2 and not taken_since(b, c)
         ),
         key=lambda c: c.distance_to(x, y),
     )
@@ -307,7 +312,7 @@ def account_for_vanished(b, found: List[Observation]):
         for o in b.seen
         if near_the_edge(b.pickup.area, o)  # elsewhere: moved, or under another, still on the mat
         # taken itself (a neighbour taken beside it does not count)
-        and all(math.hypot(o.x - x, o.y - y) > SAME_SHERD for x, y in b.taken_since_survey)
+        and not taken_since(b, o)
         and not seen_apart(o, found)
     ]
     looked_for = [o for _, _, o in near]
