@@ -168,6 +168,18 @@ TEST(GraspPlanner, MovesTheGraspAlongAnElongatedSherdPastNeighboursBesideItsMidd
   EXPECT_LT(t.grasp.translation().x(), 0.2 - 0.01);
 }
 
+TEST(GraspPlanner, MovesAnElongatedSherdsGraspBeforeTurningItFarAndTurnsARoundOne) {
+  // 30 degrees off the minor axis an elongated sherd's fingers close near its narrow ends; moved
+  // 45 % of the half-length they still close across it. A round sherd turns freely.
+  using Offer = GraspPlanner::Offer;
+  const Offer turned30{30.0, 0.0}, moved45{0.0, 0.45}, turned45{45.0, 0.0}, moved25{0.0, 0.25};
+  EXPECT_LT(GraspPlanner::holdCost(moved45, 0.45), GraspPlanner::holdCost(turned30, 0.45));
+  EXPECT_LT(GraspPlanner::holdCost(moved25, 0.45), GraspPlanner::holdCost(Offer{15.0, 0.25}, 0.45));
+  EXPECT_LT(GraspPlanner::holdCost(turned45, 0.05), GraspPlanner::holdCost(moved25, 0.05));
+  EXPECT_EQ(GraspPlanner::holdCost(Offer{0.0, 0.0}, 0.6), 0.0);  // the minor axis first, always
+  EXPECT_EQ(GraspPlanner::holdCost(turned30, 0.4), GraspPlanner::holdCost(turned30, 0.9));  // in full
+}
+
 TEST(GraspPlanner, KeepsTheGripperBarOffANeighbourStandingBeyondTheFingers) {
   // 60 x 36 mm along x at (0.2, 0.25), 8 mm high; a neighbour standing on its edge along one
   // long side, 40-48 mm off the axis (past the fingers, which reach 32 mm), x within 60 mm. At

@@ -811,13 +811,23 @@ void alongLength(const Frame& f, const SherdDetection& s, int& along) {
   std::printf("%s (%.0f x %.0f mm, elongation %.2f) seen %.0f x %.0f mm, grasp closing %.2f along its length\n",
               t.name.c_str(), t.length * 1e3, t.width * 1e3, t.ownElongation(), s.length * 1e3, s.width * 1e3, a);
 }
+
+/// The simulator's slip model's chance that grasp `s` lets its sherd go (off its true centre,
+/// closing along its own length): summed over a test's grasps, the drops to expect.
+double slipChance(const Frame& f, const SherdDetection& s) {
+  const Truth& t = truthOf(f, s);
+  const double off_m = (s.grasp.translation().head<2>() - t.centre).norm();
+  const double off = std::min(1.0, off_m / std::max(1e-3, 0.5 * t.length));
+  return rascal_sim::SlipModel::chance(off, t.closingAlong(s.grasp.linear().col(1)), t.ownElongation(), false);
+}
 }  // namespace
 
 TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
   // Heaps tipped out on the mat and settled; every grasp the detector offers as clear is laid on
   // the simulator's truth (cameDownOn; heap_25_offcentre seed 73: a finger beside a sherd
   // called clear pushed its neighbour, and that one another, off the mat). Printed per case.
-  int offered = 0, on_neighbour = 0, along = 0;
+  int offered = 0, on_neighbour = 0, along = 0, uncovered = 0;
+  double expected = 0.0, expected_all = 0.0;
   for (unsigned seed = 141; seed <= 150; ++seed) {
     const rascal_sim::Scenario sc = generatedHeap(seed, 14, 0.025);
     const Frame f = render(sc, surveyJoints(), 1.5);
@@ -825,8 +835,12 @@ TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
     const DetectionResult r = calibrateAndDetect(sc, f, d);
     if (seed <= 142) save("heap_grasps_" + std::to_string(seed), f, r);
     for (const SherdDetection& s : r.sherds) {
-      if (!s.grasp_clear || s.covered > 0.05) continue;  // what the task layer takes first
+      if (s.covered > 0.05) continue;
+      ++uncovered;
+      expected_all += slipChance(f, s);
+      if (!s.grasp_clear) continue;  // what the task layer takes first
       ++offered;
+      expected += slipChance(f, s);
       alongLength(f, s, along);
       int mm2 = 0;
       double over = 0.0;
@@ -840,6 +854,8 @@ TEST(StackedSherds, GraspsOfferedClearKeepTheFingersOffTheNeighbours) {
   }
   std::printf("heaps: %d grasps offered clear, %d come down on a neighbour, %d close along a sherd's own length\n",
               offered, on_neighbour, along);
+  std::printf("heaps: slips to expect %.3f a clear grasp (%d), %.3f a grasp of an uncovered sherd (%d)\n",
+              expected / std::max(1, offered), offered, expected_all / std::max(1, uncovered), uncovered);
   ASSERT_GE(offered, 30);
   EXPECT_LE(on_neighbour, 0.05 * offered);
 }
@@ -850,6 +866,7 @@ TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbour
   // grasps, offered clear, are laid on the truth as above, on small and big heaps (25 sherds
   // spread as heap_25_offcentre's); four sherds a heap.
   int offered = 0, on_neighbour = 0, along = 0;
+  double expected = 0.0;
   for (unsigned seed = 141; seed <= 150; ++seed) {
     const bool big = seed % 2;
     const rascal_sim::Scenario sc = generatedHeap(seed, big ? 25 : 14, big ? 0.035 : 0.025);
@@ -870,6 +887,7 @@ TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbour
       EXPECT_EQ(truthOf(f, *s).name, truthOf(survey, s0).name) << "seed " << seed << ": another sherd seen nearest";
       if (!s->grasp_clear || s->covered > 0.05) continue;
       ++offered;
+      expected += slipChance(f, *s);
       alongLength(f, *s, along);
       int mm2 = 0;
       double over = 0.0;
@@ -883,6 +901,7 @@ TEST(StackedSherds, GraspsSeenAgainFromOverTheSherdKeepTheFingersOffTheNeighbour
   }
   std::printf("seen again: %d grasps offered clear, %d come down on a neighbour, %d close along a sherd's own length\n",
               offered, on_neighbour, along);
+  std::printf("seen again: slips to expect %.3f a grasp\n", expected / std::max(1, offered));
   ASSERT_GE(offered, 30);
   EXPECT_LE(on_neighbour, 0.05 * offered);
 }

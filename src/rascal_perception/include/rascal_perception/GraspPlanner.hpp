@@ -10,10 +10,11 @@
 //
 // With the height map (GraspContext) the fingers' footprints are checked too: each finger, 20 mm
 // wide and 8 mm thick, beside the sherd at the opening, must close above what lies there (a
-// neighbour in a heap). The minor axis is tried first, then the offers of kOffers in turn: turned
-// by 15, 30, 45 and 90 degrees (the opening follows the outline's extent across each), and
-// across the minor axis moved along the sherd by a quarter and by 45 % of its half-length (the
-// opening follows the outline's extent within the fingers' width there); the first clear one
+// neighbour in a heap). The minor axis is tried first, then the offers of kOffers, least holdCost
+// first: turned by 15, 30, 45 and 90 degrees (the opening follows the outline's extent across
+// each), moved along the sherd by a quarter and by 45 % of its half-length (the opening follows
+// the outline's extent within the fingers' width there), and turned 15 degrees and moved by a
+// quarter; an elongated sherd is moved before it is turned far, a round one turned; the first clear one
 // whose chord the fingers can hold (holdableChord) is taken (grasp_clear unless its chord is
 // much longer than the minor axis's, kMaxChordRatio, while the minor axis itself could be held),
 // else the clearest holdable one, else the clearest (grasp_clear false).
@@ -58,13 +59,22 @@ class GraspPlanner {
   /// chord no longer than the middle's, for a sherd narrowing to its ends), with the sherd's
   /// mass off the grasp by the shift: a neighbour beside the sherd's middle is missed that way,
   /// where a turn of 30 or 45 degrees would close near its ends (heap_20 seed 58: three sherds of 20 turned 40-70 degrees, the model's
-  /// slip chance 0.26-0.32 each). Tried in this order, nearest the minor axis first.
+  /// slip chance 0.26-0.32 each). Tried in the order of holdCost, least first.
   struct Offer {
     double turn_deg, shift;
   };
-  static constexpr Offer kOffers[] = {{0.0, 0.0},   {15.0, 0.0},  {-15.0, 0.0}, {0.0, 0.25}, {0.0, -0.25},
-                                      {30.0, 0.0},  {-30.0, 0.0}, {0.0, 0.45},  {0.0, -0.45}, {45.0, 0.0},
-                                      {-45.0, 0.0}, {90.0, 0.0}};
+  static constexpr Offer kOffers[] = {{0.0, 0.0},    {15.0, 0.0},  {-15.0, 0.0},   {0.0, 0.25},  {0.0, -0.25},
+                                      {15.0, 0.25},  {15.0, -0.25}, {-15.0, 0.25}, {-15.0, -0.25}, {30.0, 0.0},
+                                      {-30.0, 0.0},  {0.0, 0.45},  {0.0, -0.45},   {45.0, 0.0},  {-45.0, 0.0},
+                                      {90.0, 0.0}};
+  /// How much worse an offer holds than the minor axis through the centre, for a sherd of
+  /// `elongation` (1 - width / length): the shift squared (the mass's lever about the line the
+  /// fingers close on) plus the sine of the turn squared (how far along the length they close),
+  /// the latter in full from kElongated and less on a rounder sherd, which turns freely. Not a
+  /// measured figure: the shape of the simulator's slip model (rascal_sim::SlipModel), whose
+  /// causes are the ones that hold for a real sherd. Ties keep kOffers' order.
+  static double holdCost(const Offer& offer, double elongation);
+  static constexpr double kElongated = 0.4;
 
   /// Throws std::invalid_argument when config.gripper has no finger limits (not read from a URDF).
   explicit GraspPlanner(const PerceptionConfig& config);

@@ -79,6 +79,11 @@ double outlineGap(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen
 }
 }  // namespace
 
+double GraspPlanner::holdCost(const Offer& offer, double elongation) {
+  const double turn = std::sin(offer.turn_deg * M_PI / 180.0);
+  return offer.shift * offer.shift + turn * turn * std::clamp(elongation / kElongated, 0.0, 1.0);
+}
+
 GraspPlanner::GraspPlanner(const PerceptionConfig& config) : config_(config) {
   const rascal_workcell::GripperGeometry& g = config_.gripper;
   if (!(g.minOpening() > 0.0 && g.maxOpening() > g.minOpening())) {
@@ -104,7 +109,12 @@ void GraspPlanner::plan(SherdDetection& s, const GraspContext* context) const {
     };
     std::vector<Candidate> candidates;
     double chord0 = 0.0;  // across the minor axis
-    for (const Offer& offer : kOffers) {
+    const double elongation = s.length > 0.0 ? 1.0 - s.width / s.length : 0.0;
+    std::vector<Offer> offers(std::begin(kOffers), std::end(kOffers));
+    std::stable_sort(offers.begin(), offers.end(), [elongation](const Offer& a, const Offer& b) {
+      return holdCost(a, elongation) < holdCost(b, elongation);
+    });
+    for (const Offer& offer : offers) {
       const double y = s.yaw + offer.turn_deg * M_PI / 180.0;
       const Eigen::Vector2d across(-std::sin(y), std::cos(y));  // the fingers close along R*y
       const Eigen::Vector2d along(std::cos(y), std::sin(y));
