@@ -374,6 +374,18 @@ def test_of_free_sherds_one_whose_grasp_is_turned_off_its_minor_axis_goes_after_
     assert in_pick_order([a, b, c], "nearest") == [c, a, b]
 
 
+def test_of_free_sherds_one_grasped_far_off_its_middle_goes_after_the_others():
+    # a (nearest, 60 mm long) has neighbours beside its middle: perception moved its grasp 45 %
+    # of its half-length along it (13.5 mm); b's was moved a quarter, which holds nearly as well
+    a = _obs(0.10, 0.20, 0.060, 0.030)
+    a.grasp_x += 0.45 * 0.030
+    b = _obs(0.20, 0.20, 0.050, 0.030)
+    b.grasp_y -= 0.25 * 0.025
+    c = _obs(0.30, 0.30, 0.040, 0.030)
+    assert a.grasp_shift == pytest.approx(0.45) and b.grasp_shift == pytest.approx(0.25)
+    assert in_pick_order([a, b, c], "nearest") == [b, c, a]
+
+
 def test_a_covered_sherd_is_never_taken_from_an_old_survey(data):
     batch = _batch(config_from_dict(data))
     free, under = _obs(0.10, 0.20, 0.04, 0.03), _obs(0.12, 0.2, 0.04, 0.03)

@@ -51,6 +51,12 @@ class Observation:
         return math.remainder(self.grasp_yaw - self.yaw, math.pi)
 
     @property
+    def grasp_shift(self) -> float:
+        """How far off its centre its grasp closes, a fraction of its half-length: perception
+        moves it along the sherd where a neighbour beside the middle blocks a finger (a heap)."""
+        return math.hypot(self.grasp_x - self.x, self.grasp_y - self.y) / max(1e-3, self.length / 2)
+
+    @property
     def own_height(self) -> float:
         """Its height as it lies, from what it rests on (in a heap: not the sherd under it)."""
         return max(self.height - self.support, 0.0)

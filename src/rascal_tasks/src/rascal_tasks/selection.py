@@ -16,6 +16,11 @@ COVERED = 0.05
 # slips more: such a sherd is taken after the others of its kind, by when its neighbours may be
 # gone (perception's candidates: 0, 15, 30, 45 and 90 degrees).
 TURNED = math.radians(20.0)
+# A grasp moved further than this (a fraction of the half-length) along the sherd off its centre
+# holds it by a lever as long: taken after the others of its kind as one turned is (perception's
+# offers: moved 0.25 and 0.45; held 0.45 off, the simulator's slip model gives it the chance of
+# one turned 25 degrees on an elongated sherd).
+MOVED = 0.35
 # [m] a sherd seen this near where one slipped out of the fingers as often as the recovery
 # allows is that one (a drop scatters it by a centimetre or two: recovery.unlikeness)
 SLIPPED_HERE = 0.03
@@ -142,6 +147,12 @@ def turned(o: Observation) -> bool:
     return abs(o.grasp_turn) > TURNED
 
 
+def held_far_off(o: Observation) -> bool:
+    """Whether its grasp is turned off its minor axis (`turned`) or moved along it far off its
+    centre (MOVED)."""
+    return turned(o) or o.grasp_shift > MOVED
+
+
 def in_pick_order(found: List[Observation], policy: str, slipped_from=()) -> List[Observation]:
     """`found` in the order to pick it: sherds nothing lies on first (the top of a heap), the
     least covered of the rest after them; of alike covered ones, those that did not slip out of
@@ -149,7 +160,8 @@ def in_pick_order(found: List[Observation], policy: str, slipped_from=()) -> Lis
     `slipped_from`: taken after the others, whose going may leave it a grasp that holds; heap_20
     seed 60 dropped one grasped along its length six times from amid its neighbours), then those
     whose fingers clear the neighbours (perception's grasp_clear), and of those the ones whose
-    grasp closes across their minor axis (not `turned`); then by `policy`:
+    grasp closes across their minor axis near their middle (not `held_far_off`); then by
+    `policy`:
     - nearest: nearest the arm's base first (the shortest reach, the least time; the default);
     - largest: largest length x width first;
     - most_isolated: largest edge-to-edge gap to its nearest neighbour first.
@@ -174,7 +186,7 @@ def in_pick_order(found: List[Observation], policy: str, slipped_from=()) -> Lis
             o.covered if covered(o) else 0.0,
             slipped_here(o, slipped_from),
             not o.grasp_clear,
-            turned(o),
+            held_far_off(o),
         ),
     )
 
