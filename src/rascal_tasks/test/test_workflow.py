@@ -15,7 +15,14 @@ from rascal_tasks.recovery import Recover
 from rascal_tasks.resume import PUT_BACK_HEIGHT, Calibrate, Home, Resume
 from rascal_tasks.selection import in_pick_order
 from rascal_tasks.sherd_record import SherdRecord
-from rascal_tasks.singulation import PUSH, path_clear, push_direction, pusher_clear
+from rascal_tasks.singulation import (
+    PUSH,
+    SHORT_PUSH,
+    path_clear,
+    push_direction,
+    push_plan,
+    pusher_clear,
+)
 from rascal_tasks.station_states import AtStation
 from rascal_tasks.config import Rect, config_from_dict, merged
 from rascal_tasks.survey import NextSherd, lawnmower, merge, on_the_mat
@@ -547,6 +554,16 @@ def test_a_push_keeps_the_sherd_on_the_mat_and_moves_it_away_from_its_neighbours
     # hemmed in on all four sides, no push is tried
     above = _obs(0.16, 0.30, 0.05, 0.04)
     assert push_direction(o, [o, left, right, below, above], area) is None
+    assert push_plan(o, [o, left, right, below, above], area) is None
+    # with a neighbour 25 mm ahead (where the fingers would come down to push the other way),
+    # a full push would drive it in; a short one frees a finger's room from its neighbours and
+    # stops short of that one
+    near = _obs(0.16, 0.305, 0.05, 0.02)  # its near edge 25 mm beyond o's
+    hemmed = [o, left, right, near]
+    assert push_direction(o, hemmed, area) is None
+    d, travel = push_plan(o, hemmed, area)
+    assert travel == SHORT_PUSH and d[1] > 0.85 and path_clear(o, d, hemmed, travel)
+    assert push_plan(o, [o, left, right], area)[1] == PUSH  # a full push where one is clear
     # in a corner the only pushes left are inwards, and none may end off the mat
     corner = _obs(0.045, 0.205, 0.05, 0.04)
     dx, dy = push_direction(corner, [corner], area)

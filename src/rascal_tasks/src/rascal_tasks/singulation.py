@@ -23,6 +23,10 @@ from rascal_tasks.rig import Leftover, Observation, RigError
 from rascal_tasks.selection import STACKED, same_size
 
 PUSH = 0.04  # [m] how far the sherd's centre is pushed: most of a neighbour's width
+# [m] how far where no full push has a clear path: a finger's thickness and the grasp margin
+# (8 + 6 mm) freed beside it, and a few millimetres over (in a heap a full push's 40 mm strip
+# met a neighbour 12 of 14 times in session 45's runs; each refused one was grasped turned)
+SHORT_PUSH = 0.02
 LEAD = 0.015  # [m] the fingers start this far outside its outline
 EDGE = 0.01  # [m] a pushed sherd keeps its outline this far inside the mat
 DIRECTIONS = 16
@@ -44,17 +48,31 @@ SLID_PAST = 0.001
 
 
 def push_direction(
-    o: Observation, others: List[Observation], area
+    o: Observation, others: List[Observation], area, travel: float = PUSH
 ) -> Optional[Tuple[float, float]]:
-    """The unit direction (dx, dy) to push `o` in: where it ends farthest from its neighbours'
-    outlines, its own outline still `EDGE` inside `area` (a config.Rect); None if no push
-    keeps it on the mat."""
+    """The unit direction (dx, dy) to push `o` in by `travel`: where it ends farthest from its
+    neighbours' outlines, its own outline still `EDGE` inside `area` (a config.Rect), the
+    fingers and its path clear of them; None if there is none."""
     directions = [
         (math.cos(2 * math.pi * k / DIRECTIONS), math.sin(2 * math.pi * k / DIRECTIONS))
         for k in range(DIRECTIONS)
     ]
-    clear = [d for d in directions if pusher_clear(o, d, others) and path_clear(o, d, others)]
-    return _roomiest(o, clear, PUSH, o.length / 2 + EDGE, others, area)
+    clear = [
+        d for d in directions if pusher_clear(o, d, others) and path_clear(o, d, others, travel)
+    ]
+    return _roomiest(o, clear, travel, o.length / 2 + EDGE, others, area)
+
+
+def push_plan(
+    o: Observation, others: List[Observation], area
+) -> Optional[Tuple[Tuple[float, float], float]]:
+    """How to push `o` apart from `others`: (direction, travel), a full PUSH where one has a
+    clear path, else a SHORT_PUSH; None if neither has."""
+    for travel in (PUSH, SHORT_PUSH):
+        d = push_direction(o, others, area, travel)
+        if d is not None:
+            return d, travel
+    return None
 
 
 def push_start(o: Observation, d: Tuple[float, float]) -> Tuple[float, float]:
@@ -73,9 +91,11 @@ def pusher_clear(o: Observation, d: Tuple[float, float], others: List[Observatio
     return not any(_boxes_overlap(pusher, _box(c, PUSHER_CLEARANCE)) for c in others if c is not o)
 
 
-def path_clear(o: Observation, d: Tuple[float, float], others: List[Observation]) -> bool:
-    """Whether `o`, pushed PUSH along `d`, sweeps into no neighbour: the strip its outline box
-    covers ahead of it (from its leading edge PUSH on, as wide across `d` as the box, less
+def path_clear(
+    o: Observation, d: Tuple[float, float], others: List[Observation], travel: float = PUSH
+) -> bool:
+    """Whether `o`, pushed `travel` along `d`, sweeps into no neighbour: the strip its outline box
+    covers ahead of it (from its leading edge `travel` on, as wide across `d` as the box, less
     SLID_PAST each side) meets no neighbour's outline box but those it lies on (their tops no
     higher than what it rests on: it is pushed at its own mid-height and slides off them).
     heap_20 seed 116: a push drove a sherd into a stack of three lying near the mat's edge; they
@@ -85,8 +105,8 @@ def path_clear(o: Observation, d: Tuple[float, float], others: List[Observation]
     rel = o.yaw - theta
     ahead = abs(o.length / 2 * math.cos(rel)) + abs(o.width / 2 * math.sin(rel))
     across = abs(o.length / 2 * math.sin(rel)) + abs(o.width / 2 * math.cos(rel))
-    mid = ahead + PUSH / 2
-    strip = ((o.x + mid * d[0], o.y + mid * d[1]), theta, PUSH / 2, across - SLID_PAST)
+    mid = ahead + travel / 2
+    strip = ((o.x + mid * d[0], o.y + mid * d[1]), theta, travel / 2, across - SLID_PAST)
     own = _box(o, 0.0)
     return not any(
         _boxes_overlap(strip, _box(c, 0.0))
@@ -146,11 +166,11 @@ def _roomiest(
     return best
 
 
-def push(b, o: Observation, d: Tuple[float, float]) -> bool:
-    """Push `o` along `d` (see the module). False when the arm refuses a move of it (the
-    sherd is then left for a person); other rig errors stop the batch as anywhere."""
+def push(b, o: Observation, d: Tuple[float, float], travel: float = PUSH) -> bool:
+    """Push `o` by `travel` along `d` (see the module). False when the arm refuses a move of it
+    (the sherd is then left for a person); other rig errors stop the batch as anywhere."""
     start = push_start(o, d)
-    end = (o.x + PUSH * d[0], o.y + PUSH * d[1])
+    end = (o.x + travel * d[0], o.y + travel * d[1])
     # the fingers close across the push: both touch the sherd
     return _sweep(b, (o.x, o.y), start, end, o.grasp_z, math.atan2(d[1], d[0]))
 
@@ -161,17 +181,20 @@ def part_from_neighbours(b, o: Observation, others: List[Observation], key, afte
     on the mat; said, `after` saying why. True when it was pushed."""
     if was_pushed(b, o) or not _spend_push(b, key):
         return False
-    d = push_direction(o, others, b.pickup.area)
-    if d is None or not push(b, o, d):
+    plan = push_plan(o, others, b.pickup.area)
+    if plan is None:
         return False
-    sent = ((o.x + PUSH * d[0], o.y + PUSH * d[1]), o)
+    d, travel = plan
+    if not push(b, o, d, travel):
+        return False
+    sent = ((o.x + travel * d[0], o.y + travel * d[1]), o)
     b.pushed_to.append(sent)
     b.pushed_since_survey.append(sent)  # looked for there by the next survey's edge check
     b.event(
         None,
         "pushed",
         "sherd at (%.3f, %.3f) m pushed %.0f mm towards (%.2f, %.2f) %s, to part it from its "
-        "neighbours" % (o.x, o.y, PUSH * 1000, d[0], d[1], after),
+        "neighbours" % (o.x, o.y, travel * 1000, d[0], d[1], after),
     )
     return True
 
