@@ -8,6 +8,7 @@ from fake_rig import Recorder, Sherd, World, riding_world, run_batch, shipped_co
 
 from rascal_tasks import workflow
 from rascal_tasks.layout_bound import sequence
+from rascal_tasks.run_batch import what_is_left
 from rascal_tasks.stations import ScaleStation
 
 LAYOUT = "config/layouts/one_station.yaml"
@@ -93,7 +94,7 @@ def test_a_sherd_left_on_the_scale_is_taken_to_the_mat_before_the_batch_ends(con
     world = World(config, [big, rider])
     world.doubles = {"big": "rider"}  # the first grasp of `big` lifts `rider` too
     world.scale_settle = 1.5  # the pan not steady yet when the arm is at the discard box
-    outcome, _batch, rec = run_batch(config, world)
+    outcome, batch, rec = run_batch(config, world)
     assert outcome == "finished" and rec.status() == {1: "done", 2: "done"}
     assert rec.sherds[2].mass == pytest.approx(0.015)  # weighed on its own, later
     assert {s.station for s in world.sherds} == {"discard"}
@@ -102,6 +103,10 @@ def test_a_sherd_left_on_the_scale_is_taken_to_the_mat_before_the_batch_ends(con
     # mass by difference is said on it
     assert rec.sherds[1].mass == pytest.approx(0.045)
     assert any("its own mass by difference 30.0 g" in n for n in rec.sherds[1].notes)
+    # and its photo, shot on the pan, had the rider in it: said on the row, a person to look
+    assert any("archival photo was taken with that one" in n for n in rec.sherds[1].notes)
+    assert batch.photo_with_another == [1]
+    assert "photographed with another sherd" in what_is_left(batch, [])
 
 
 def test_what_a_thick_sherd_taken_up_high_leaves_on_the_pan_is_weighed_out_of_its_row(config):

@@ -22,6 +22,7 @@ from rascal_tasks.singulation import (
     push_direction,
     push_plan,
     pusher_clear,
+    why_not_pushed,
 )
 from rascal_tasks.station_states import AtStation
 from rascal_tasks.config import Rect, config_from_dict, merged
@@ -555,6 +556,8 @@ def test_a_push_keeps_the_sherd_on_the_mat_and_moves_it_away_from_its_neighbours
     above = _obs(0.16, 0.30, 0.05, 0.04)
     assert push_direction(o, [o, left, right, below, above], area) is None
     assert push_plan(o, [o, left, right, below, above], area) is None
+    why = why_not_pushed(o, [o, left, right, below, above], area)
+    assert why.startswith("of 16 directions, 16 with the fingers on a neighbour"), why
     # with a neighbour 25 mm ahead (where the fingers would come down to push the other way),
     # a full push would drive it in; a short one frees a finger's room from its neighbours and
     # stops short of that one

@@ -10,13 +10,15 @@
 //
 // With the height map (GraspContext) the fingers' footprints are checked too: each finger, 20 mm
 // wide and 8 mm thick, beside the sherd at the opening, must close above what lies there (a
-// neighbour in a heap). The minor axis is tried first, then the offers of kOffers, least holdCost
-// first: turned by 15, 30, 45 and 90 degrees (the opening follows the outline's extent across
-// each), moved along the sherd by a quarter and by 45 % of its half-length (the opening follows
-// the outline's extent within the fingers' width there), and turned 15 degrees and moved by a
-// quarter; an elongated sherd is moved before it is turned far, a round one turned; the first clear one
-// whose chord the fingers can hold (holdableChord) is taken (grasp_clear unless its chord is
-// much longer than the minor axis's, kMaxChordRatio, while the minor axis itself could be held),
+// neighbour in a heap). The minor axis is tried first, then the offers of kOffers, least
+// holdCost first: turned by 15, 20, 25, 30, 45 and 90 degrees (the opening follows the outline's
+// extent across each: the least turn that clears a neighbour, or whose chord a sherd too narrow
+// to hold across can be held by), moved along the sherd by a quarter and by 45 % of its
+// half-length (the opening follows the outline's extent within the fingers' width there), and
+// turned 15 degrees and moved by a quarter; an elongated sherd is moved before it is turned far,
+// a round one turned. The first clear one whose chord the fingers can hold (holdableChord) is
+// taken (grasp_clear unless its chord is much longer than the minor axis's, kMaxChordRatio,
+// while the minor axis itself could be held),
 // else the clearest holdable one, else the clearest (grasp_clear false).
 #include <opencv2/core.hpp>
 #include <vector>
@@ -63,10 +65,10 @@ class GraspPlanner {
   struct Offer {
     double turn_deg, shift;
   };
-  static constexpr Offer kOffers[] = {{0.0, 0.0},    {15.0, 0.0},  {-15.0, 0.0},   {0.0, 0.25},  {0.0, -0.25},
-                                      {15.0, 0.25},  {15.0, -0.25}, {-15.0, 0.25}, {-15.0, -0.25}, {30.0, 0.0},
-                                      {-30.0, 0.0},  {0.0, 0.45},  {0.0, -0.45},   {45.0, 0.0},  {-45.0, 0.0},
-                                      {90.0, 0.0}};
+  static constexpr Offer kOffers[] = {{0.0, 0.0},    {15.0, 0.0},   {-15.0, 0.0},   {0.0, 0.25},   {0.0, -0.25},
+                                      {15.0, 0.25},  {15.0, -0.25}, {-15.0, 0.25},  {-15.0, -0.25}, {20.0, 0.0},
+                                      {-20.0, 0.0},  {25.0, 0.0},   {-25.0, 0.0},   {30.0, 0.0},   {-30.0, 0.0},
+                                      {0.0, 0.45},   {0.0, -0.45},  {45.0, 0.0},    {-45.0, 0.0},  {90.0, 0.0}};
   /// How much worse an offer holds than the minor axis through the centre, for a sherd of
   /// `elongation` (1 - width / length): the shift squared (the mass's lever about the line the
   /// fingers close on) plus the sine of the turn squared (how far along the length they close),

@@ -91,6 +91,9 @@ class Batch:
         self.put_back_at = []  # (x, y) of the pickup mat where a put back set sherds down
         self.two_seen = []  # seqs recorded with a second sherd seen on the scale (put back twice)
         self.maybe_two = []  # seqs recorded as one outline whose wall its mass rules out (a note)
+        # seqs photographed over the scale with a sherd on the pan that stayed there when it was
+        # lifted off (stations.ScaleStation._left_on_pan)
+        self.photo_with_another = []
         # (station name, kg, seq weighed with it): a sherd that stayed on a station's pan and
         # could not be taken to the mat (stations.ScaleStation._left_on_pan), for a person
         self.left_on_station: List[tuple] = []

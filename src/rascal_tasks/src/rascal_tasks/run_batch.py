@@ -287,6 +287,7 @@ class Run:
                 batch.put_back_at = done[-1].put_back_at
                 batch.two_seen = done[-1].two_seen
                 batch.maybe_two = done[-1].maybe_two
+                batch.photo_with_another = done[-1].photo_with_another
                 batch.left_on_station = done[-1].left_on_station
             progress.batch = batch
             self.batch, self.machine = batch, build_machine(batch)
@@ -503,7 +504,8 @@ def what_is_left(batch, rows) -> str:
     lost, without a mass (the scale gave none that could be trusted: mass_unstable, or done with
     mass_missing_reason) or unfinished, rows weighed with a second sherd seen on the scale
     (stations.LOOK_PUT_BACKS), rows that may be two lying as one (stations.ScaleStation.
-    _maybe_two), and sherds left on the scale's pan (ScaleStation._left_on_pan)."""
+    _maybe_two), rows photographed over the scale with another sherd on its pan and sherds left
+    on the pan (ScaleStation._left_on_pan)."""
     rows = rows or []
     counts = (
         (len(batch.unpickable), "left on the pickup mat (could not be picked up)"),
@@ -516,6 +518,10 @@ def what_is_left(batch, rows) -> str:
         (sum(r["status"] not in ("done", "lost") for r in rows), "unfinished"),
         (len(batch.two_seen), "recorded with a second sherd seen on the scale (`two_seen`)"),
         (len(batch.maybe_two), "recorded as one that may be two lying as one (`maybe_two`)"),
+        (
+            len(batch.photo_with_another),
+            "photographed with another sherd on the scale's pan (`photo_with_another`)",
+        ),
         (
             len(batch.left_on_station),
             "left on the scale (came up with another, not taken off there: listed above)",

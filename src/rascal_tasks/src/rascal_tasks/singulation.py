@@ -75,6 +75,24 @@ def push_plan(
     return None
 
 
+def why_not_pushed(o: Observation, others: List[Observation], area) -> str:
+    """Why no push of `o` is tried (push_plan None), counted over its DIRECTIONS directions:
+    how many the closed fingers would come down on a neighbour (pusher_clear), how many more
+    drive it into one even by SHORT_PUSH (path_clear), and how many of the rest leave it less
+    than EDGE inside the mat. For tracing a run."""
+    fingers = path = 0
+    for k in range(DIRECTIONS):
+        d = (math.cos(2 * math.pi * k / DIRECTIONS), math.sin(2 * math.pi * k / DIRECTIONS))
+        if not pusher_clear(o, d, others):
+            fingers += 1
+        elif not path_clear(o, d, others, SHORT_PUSH):
+            path += 1
+    return (
+        "of %d directions, %d with the fingers on a neighbour, %d with one in its path, %d "
+        "ending off the mat" % (DIRECTIONS, fingers, path, DIRECTIONS - fingers - path)
+    )
+
+
 def push_start(o: Observation, d: Tuple[float, float]) -> Tuple[float, float]:
     """Where the closed fingers come down to push `o` along `d`: LEAD outside its outline."""
     back = o.length / 2 + LEAD
@@ -179,10 +197,21 @@ def part_from_neighbours(b, o: Observation, others: List[Observation], key, afte
     """Push `o` apart from its neighbours (`others`), once per spot (`key`, rounded (x, y)) and
     once per sherd (was_pushed), if the batch has pushes left (MAX_PUSHES) and a push keeps it
     on the mat; said, `after` saying why. True when it was pushed."""
-    if was_pushed(b, o) or not _spend_push(b, key):
+    if was_pushed(b, o):
+        b.log("the sherd at (%.3f, %.3f) m is not pushed: pushed before" % (o.x, o.y))
+        return False
+    if not _spend_push(b, key):
+        b.log(
+            "the sherd at (%.3f, %.3f) m is not pushed: this spot pushed before, or the "
+            "batch's %d pushes spent" % (o.x, o.y, MAX_PUSHES)
+        )
         return False
     plan = push_plan(o, others, b.pickup.area)
     if plan is None:
+        b.log(
+            "the sherd at (%.3f, %.3f) m is not pushed: %s"
+            % (o.x, o.y, why_not_pushed(o, others, b.pickup.area))
+        )
         return False
     d, travel = plan
     if not push(b, o, d, travel):
