@@ -53,14 +53,18 @@ def push_direction(
     """The unit direction (dx, dy) to push `o` in by `travel`: where it ends farthest from its
     neighbours' outlines, its own outline still `EDGE` inside `area` (a config.Rect), the
     fingers and its path clear of them; None if there is none."""
-    directions = [
+    clear = [
+        d for d in _directions() if pusher_clear(o, d, others) and path_clear(o, d, others, travel)
+    ]
+    return _roomiest(o, clear, travel, o.length / 2 + EDGE, others, area)
+
+
+def _directions() -> List[Tuple[float, float]]:
+    """The DIRECTIONS unit directions a push is tried along, evenly round."""
+    return [
         (math.cos(2 * math.pi * k / DIRECTIONS), math.sin(2 * math.pi * k / DIRECTIONS))
         for k in range(DIRECTIONS)
     ]
-    clear = [
-        d for d in directions if pusher_clear(o, d, others) and path_clear(o, d, others, travel)
-    ]
-    return _roomiest(o, clear, travel, o.length / 2 + EDGE, others, area)
 
 
 def push_plan(
@@ -81,8 +85,7 @@ def why_not_pushed(o: Observation, others: List[Observation], area) -> str:
     drive it into one even by SHORT_PUSH (path_clear), and how many of the rest leave it less
     than EDGE inside the mat. For tracing a run."""
     fingers = path = 0
-    for k in range(DIRECTIONS):
-        d = (math.cos(2 * math.pi * k / DIRECTIONS), math.sin(2 * math.pi * k / DIRECTIONS))
+    for d in _directions():
         if not pusher_clear(o, d, others):
             fingers += 1
         elif not path_clear(o, d, others, SHORT_PUSH):

@@ -345,7 +345,7 @@ class ScaleStation(StationPlugin):
             if own >= MIN_SHERD_MASS and s.status in ("weighed", "photographed"):
                 s.record_mass_by_difference(round(own, 7))
                 text += ", recorded"
-            if any(st.over_scale for st in b.config.stations.values()):
+            if b.next_stays(self.index) is not None:
                 # the camera over the scale shot it before it was lifted, the other one on the
                 # pan with it, under it or beside it (heap_22_corner seed 124: a 36 x 35 mm sherd
                 # under a 50 x 40 mm one, the pan's look saw one outline)
